@@ -1,0 +1,386 @@
+//! Run configuration: unchecked [`SepgConfig`] → validated [`CheckedConfig`] (linfa's
+//! `ParamGuard` pattern). Only a checked configuration can build a solver.
+use sepg_bounds::constants::TaskConstants;
+use sepg_estimators::GradientSpec;
+use sepg_mdp::env::{AnyEnv, Environment};
+use serde::{Deserialize, Serialize};
+
+use crate::core::error::ConfigError;
+use crate::core::state::State;
+
+/// Safety requirement of SEPG (Table 4.1, SPEC §5).
+///
+/// Type-I requirements constrain every update, J(θᵗ⁺¹) − J(θᵗ) ≥ Cᵗ (eq. 4.2), with Cᵗ split
+/// between the v-update ((1 − ν)Cᵗ, eq. 4.13) and the w-update (νCᵗ, eq. 4.14). Type-II
+/// requirements use the budget B (Definition 4.3) with C = −B for each update and differ by
+/// their target policy.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Requirement {
+    /// Monotonic improvement: Cᵗ = 0.
+    Mi,
+    /// Lower-bounded I: Cᵗ = J(θ⁰) − J(θᵗ), split by `nu` ∈ [0, 1] (eqs. 4.13, 4.14).
+    LbI {
+        /// Share ν of Cᵗ given to the w-update.
+        nu: f64,
+    },
+    /// Lower-bounded II: budget, target = exploratory policy.
+    LbII,
+    /// Low variance: budget, target = (vᵗ, w_LV) with w_LV the lowest w allowed by (4.17)
+    /// for a worsening of at most B from the exploratory policy (Sec 4.4.3).
+    Lv,
+    /// Zero variance: budget, target = deterministic policy (vᵗ, −∞).
+    Zv,
+    /// SIM-ν (Sec 4.4.4, 5.1.3): v- and w-update computed from one batch at (vᵗ, wᵗ), the
+    /// budget split νB (v-update) / (1 − ν)B (w-update); target = deterministic policy as
+    /// in ZV (the merged block plus the target block use 2/3 of ZV's blocks).
+    Sim {
+        /// Share ν of the budget given to the v-update.
+        nu: f64,
+    },
+}
+
+impl Requirement {
+    /// Whether the requirement uses the budget B (type II, including SIM-ν).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::Requirement;
+    /// assert!(Requirement::Zv.is_type_two());
+    /// assert!(!Requirement::LbI { nu: 0.5 }.is_type_two());
+    /// ```
+    pub fn is_type_two(self) -> bool {
+        matches!(
+            self,
+            Requirement::LbII | Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+        )
+    }
+
+    /// Number of blocks one SEPG iteration runs, among which N is split evenly
+    /// (Sec 4.4.4): v and w (MI, LB-I, LB-II), v, target and w (LV, ZV), merged v/w and
+    /// target (SIM-ν).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::Requirement;
+    /// assert_eq!(Requirement::Mi.blocks(), 2);
+    /// assert_eq!(Requirement::Zv.blocks(), 3);
+    /// assert_eq!(Requirement::Sim { nu: 0.5 }.blocks(), 2);
+    /// ```
+    pub fn blocks(self) -> usize {
+        match self {
+            Requirement::Mi | Requirement::LbI { .. } | Requirement::LbII => 2,
+            Requirement::Lv | Requirement::Zv => 3,
+            Requirement::Sim { .. } => 2,
+        }
+    }
+}
+
+/// The optimisation algorithm (SPEC §5, comparison algorithms of Chapter 5).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Algorithm {
+    /// SEPG, update (4.20): greedy-coordinate v-update with the largest safe ᾱ, w-update
+    /// along ∇_w L with the largest safe β̄ (Theorems 4.2/4.5, high-probability 4.7/4.9).
+    Sepg(Requirement),
+    /// SEPG with the naive w-update along ∇_w J, eq. (4.12), β̄ = (1 + λ_w)β*
+    /// (Theorem 4.3/4.8).
+    SepgNaiveW(Requirement),
+    /// G(PO)MDP with constant steps: v ← v + α ∇̂_v J, w ← w + β ∇̂_w J.
+    GpomdpConst {
+        /// Step size α > 0 of the mean parameters.
+        alpha: f64,
+        /// Step size β ≥ 0 of the log standard deviations (0 keeps σ fixed).
+        beta: f64,
+    },
+    /// G(PO)MDP with Adam (Kingma and Ba 2015) on v and w separately.
+    GpomdpAdam {
+        /// Learning rate of v (> 0).
+        lr_v: f64,
+        /// Learning rate of w (≥ 0; 0 keeps σ fixed).
+        lr_w: f64,
+        /// First-moment decay β₁ ∈ [0, 1).
+        beta1: f64,
+        /// Second-moment decay β₂ ∈ [0, 1).
+        beta2: f64,
+        /// Denominator offset ε > 0.
+        epsilon: f64,
+    },
+    /// Adaptive step of Pirotta et al. with fixed σ: θ ← θ + α* ∇̂_θ J with α* of
+    /// Corollary 3.11 (exact) or Theorem 3.12 (sampled).
+    AdaStep,
+}
+
+impl Algorithm {
+    /// Adam with the usual defaults β₁ = 0.9, β₂ = 0.999, ε = 1e-8.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::Algorithm;
+    /// let a = Algorithm::adam(1e-4, 1e-4);
+    /// assert!(matches!(a, Algorithm::GpomdpAdam { beta1, .. } if beta1 == 0.9));
+    /// ```
+    pub fn adam(lr_v: f64, lr_w: f64) -> Self {
+        Algorithm::GpomdpAdam {
+            lr_v,
+            lr_w,
+            beta1: 0.9,
+            beta2: 0.999,
+            epsilon: 1e-8,
+        }
+    }
+
+    /// Number of trajectory blocks one iteration runs.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, Requirement};
+    /// assert_eq!(Algorithm::AdaStep.blocks(), 1);
+    /// assert_eq!(Algorithm::Sepg(Requirement::Lv).blocks(), 3);
+    /// ```
+    pub fn blocks(self) -> usize {
+        match self {
+            Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => r.blocks(),
+            _ => 1,
+        }
+    }
+
+    fn validate(self) -> Result<(), ConfigError> {
+        let hp = |name, value: f64, ok: bool, domain| {
+            if ok && value.is_finite() {
+                Ok(())
+            } else {
+                Err(ConfigError::InvalidHyperParameter {
+                    name,
+                    value,
+                    domain,
+                })
+            }
+        };
+        match self {
+            Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => match r {
+                Requirement::LbI { nu } | Requirement::Sim { nu } => {
+                    if (0.0..=1.0).contains(&nu) {
+                        Ok(())
+                    } else {
+                        Err(ConfigError::NuOutOfRange { nu })
+                    }
+                }
+                _ => Ok(()),
+            },
+            Algorithm::GpomdpConst { alpha, beta } => {
+                hp("alpha", alpha, alpha > 0.0, "(0, inf)")?;
+                hp("beta", beta, beta >= 0.0, "[0, inf)")
+            }
+            Algorithm::GpomdpAdam {
+                lr_v,
+                lr_w,
+                beta1,
+                beta2,
+                epsilon,
+            } => {
+                hp("lr_v", lr_v, lr_v > 0.0, "(0, inf)")?;
+                hp("lr_w", lr_w, lr_w >= 0.0, "[0, inf)")?;
+                hp("beta1", beta1, (0.0..1.0).contains(&beta1), "[0, 1)")?;
+                hp("beta2", beta2, (0.0..1.0).contains(&beta2), "[0, 1)")?;
+                hp("epsilon", epsilon, epsilon > 0.0, "(0, inf)")
+            }
+            Algorithm::AdaStep => Ok(()),
+        }
+    }
+}
+
+/// How J and its gradients are obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum GradientMode {
+    /// Monte Carlo estimates (G(PO)MDP, estimator of Appendix B) with t-based confidence
+    /// widths at level `delta` (Sec 4.5) and the high-probability bounds of Theorems 4.7–4.9.
+    Sampled {
+        /// Confidence parameter δ ∈ (0, 1) of each width ε_i = t(1 − δ/2, N − 1)·√(Var_i/N).
+        delta: f64,
+    },
+    /// Exact oracle values (the setting of Sec 4.3): Theorems 4.2, 4.3 and 4.5 directly,
+    /// no ε corrections.
+    Exact,
+}
+
+/// Unchecked configuration of a run. Validate it with [`SepgConfig::check`].
+///
+/// # Examples
+/// ```
+/// use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
+/// use sepg_mdp::env::Preset;
+/// let cfg = SepgConfig::new(Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Zv));
+/// assert_eq!(cfg.n_trajectories, 100);
+/// assert!(cfg.clone().check().is_ok());
+/// let bad = SepgConfig { sigma0: vec![0.0], ..cfg };
+/// assert!(bad.check().is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct SepgConfig {
+    /// The environment (its constants R, M_φ, |A|, γ enter every bound).
+    pub env: AnyEnv,
+    /// The algorithm.
+    pub algorithm: Algorithm,
+    /// Sampled or exact J and gradients.
+    pub gradient: GradientMode,
+    /// Estimator of ∇_v J and ∇_w J in the sampled mode (G(PO)MDP with the leave-one-out
+    /// variance-optimal baseline by default).
+    pub estimator: GradientSpec,
+    /// Initial mean parameters v⁰ (length `action_dim · feature_dim`, action-major).
+    pub v0: Vec<f64>,
+    /// Initial standard deviations σ⁰ > 0 (length `action_dim`); w⁰ = ln σ⁰.
+    pub sigma0: Vec<f64>,
+    /// Trajectories per iteration N, split evenly among the blocks that run (Sec 4.4.4).
+    pub n_trajectories: usize,
+    /// Horizon H of every trajectory (and of the exact oracle's finite-horizon J).
+    pub horizon: usize,
+    /// Number of iterations a full run performs.
+    pub iterations: u64,
+    /// Seed of the run; trajectory streams derive from (seed, iteration, block, index).
+    pub seed: u64,
+    /// Initial budget B⁰ ≥ 0 (Algorithm 4.3; SPEC §5 default 0).
+    pub initial_budget: f64,
+}
+
+impl SepgConfig {
+    /// The reproduction defaults of SPEC §6 for `env` and `algorithm`: v⁰ = −0.1 on every
+    /// mean parameter, σ⁰ = 1, N = 100, H = 20, 10,000 iterations, seed 0, B⁰ = 0, sampled
+    /// gradients with δ = 0.2.
+    pub fn new(env: AnyEnv, algorithm: Algorithm) -> Self {
+        let dim_v = env.action_dim() * env.feature_dim();
+        let dim_w = env.action_dim();
+        SepgConfig {
+            env,
+            algorithm,
+            gradient: GradientMode::Sampled { delta: 0.2 },
+            estimator: GradientSpec::default(),
+            v0: vec![-0.1; dim_v],
+            sigma0: vec![1.0; dim_w],
+            n_trajectories: 100,
+            horizon: 20,
+            iterations: 10_000,
+            seed: 0,
+            initial_budget: 0.0,
+        }
+    }
+
+    /// Validates the configuration (linfa's `ParamGuard::check`).
+    ///
+    /// # Errors
+    /// A [`ConfigError`] for ν ∉ [0, 1], σ⁰ ≤ 0 or non-finite, non-finite v⁰, wrong vector
+    /// lengths, δ ∉ (0, 1), zero iterations, H = 0, B⁰ < 0 or non-finite, N too small to give
+    /// every block at least 2 trajectories (4 for a block that estimates ∇_w L, whose
+    /// estimator is cross-fitted on two halves), bad hyper-parameters, exact mode without an
+    /// exact oracle, or environment constants the bounds reject.
+    pub fn check(self) -> Result<CheckedConfig, ConfigError> {
+        self.algorithm.validate()?;
+        if self.iterations == 0 {
+            return Err(ConfigError::ZeroIterations);
+        }
+        if self.horizon == 0 {
+            return Err(ConfigError::ZeroHorizon);
+        }
+        if !(self.initial_budget.is_finite() && self.initial_budget >= 0.0) {
+            return Err(ConfigError::InvalidBudget {
+                value: self.initial_budget,
+            });
+        }
+        let dim_w = self.env.action_dim();
+        let dim_v = dim_w * self.env.feature_dim();
+        for (what, expected, got) in [
+            ("v0", dim_v, self.v0.len()),
+            ("sigma0", dim_w, self.sigma0.len()),
+        ] {
+            if expected != got {
+                return Err(ConfigError::DimensionMismatch {
+                    what,
+                    expected,
+                    got,
+                });
+            }
+        }
+        if let Some((index, &value)) = self.v0.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(ConfigError::InvalidMean { index, value });
+        }
+        for (index, &value) in self.sigma0.iter().enumerate() {
+            let w = value.ln();
+            if !(value.is_finite() && value > 0.0 && w.is_finite()) {
+                return Err(ConfigError::InvalidSigma { index, value });
+            }
+        }
+        match self.gradient {
+            GradientMode::Sampled { delta } => {
+                if !(delta > 0.0 && delta < 1.0) {
+                    return Err(ConfigError::InvalidDelta { delta });
+                }
+                let blocks = self.algorithm.blocks();
+                let min = match self.algorithm {
+                    Algorithm::Sepg(_) => 4,
+                    _ => 2,
+                };
+                if self.n_trajectories / blocks < min {
+                    return Err(ConfigError::TooFewTrajectories {
+                        n: self.n_trajectories,
+                        blocks,
+                    });
+                }
+            }
+            GradientMode::Exact => {
+                let unsupported = match &self.env {
+                    AnyEnv::Lqg(e) if e.model().clipping && !e.model().is_scalar() => {
+                        Some("clipped multi-dimensional LQG")
+                    }
+                    AnyEnv::Lqg(_) => None,
+                    _ => Some("mountain-car"),
+                };
+                if let Some(env) = unsupported {
+                    return Err(ConfigError::ExactUnsupported { env: env.into() });
+                }
+            }
+        }
+        let k = self.env.constants();
+        let constants = TaskConstants::new(k.gamma, k.r_max, k.m_phi, k.action_volume)
+            .map_err(|e| ConfigError::Environment(e.to_string()))?;
+        Ok(CheckedConfig {
+            inner: self,
+            constants,
+        })
+    }
+}
+
+/// A validated [`SepgConfig`]; only this type can build a solver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckedConfig {
+    inner: SepgConfig,
+    constants: TaskConstants,
+}
+
+impl CheckedConfig {
+    /// The validated configuration.
+    pub fn config(&self) -> &SepgConfig {
+        &self.inner
+    }
+
+    /// The validated task constants R, M_φ, |A|, γ of the environment (SPEC §1).
+    pub fn constants(&self) -> &TaskConstants {
+        &self.constants
+    }
+
+    /// The state before the first iteration: (v⁰, ln σ⁰), B = B⁰.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+    /// use sepg_mdp::env::Preset;
+    /// let c = SepgConfig::new(Preset::Lqg.build(), Algorithm::Sepg(Requirement::Mi)).check()?;
+    /// let s = c.initial_state();
+    /// assert_eq!((s.v.clone(), s.w.clone()), (vec![-0.1], vec![0.0]));
+    /// # Ok::<(), sepg_algo::core::error::ConfigError>(())
+    /// ```
+    pub fn initial_state(&self) -> State {
+        State::new(
+            self.inner.v0.clone(),
+            self.inner.sigma0.iter().map(|s| s.ln()).collect(),
+            self.inner.initial_budget,
+        )
+    }
+}

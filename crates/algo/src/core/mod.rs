@@ -1,0 +1,8 @@
+//! Shared machinery of every algorithm: configuration, records, state, executor.
+pub mod adam;
+pub mod config;
+pub mod error;
+pub mod executor;
+pub mod record;
+pub mod seed;
+pub mod state;

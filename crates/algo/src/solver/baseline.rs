@@ -1,0 +1,138 @@
+//! The comparison algorithms of Chapter 5: G(PO)MDP with constant steps, with Adam, and the
+//! adaptive step of Pirotta et al. (Corollary 3.11, Theorem 3.12). Each iteration runs a
+//! single block of N trajectories at (vᵗ, wᵗ).
+use crate::core::adam::AdamMoments;
+use crate::core::config::Algorithm;
+use crate::core::error::RunError;
+use crate::core::record::Record;
+use crate::core::seed::Block;
+use crate::core::state::State;
+use sepg_bounds::constants::TaskConstants;
+
+use crate::solver::source::{GradientSource, Need, Query};
+use crate::solver::steps;
+
+/// Runs iteration `state.iteration` of a comparison algorithm (`algorithm` must not be a
+/// SEPG variant; those are handled by [`crate::solver::sepg`]).
+pub(crate) fn iterate(
+    source: &mut dyn GradientSource,
+    k: &TaskConstants,
+    algorithm: Algorithm,
+    n: usize,
+    state: &mut State,
+) -> Result<Record, RunError> {
+    let t = state.iteration;
+    let fixed_sigma = match algorithm {
+        Algorithm::GpomdpConst { beta, .. } => beta == 0.0,
+        Algorithm::GpomdpAdam { lr_w, .. } => lr_w == 0.0,
+        _ => true,
+    };
+    let e = source.estimate(&Query {
+        iteration: t,
+        block: Block::V,
+        v: &state.v,
+        w: Some(&state.w),
+        n,
+        need: Need {
+            grad_v: true,
+            grad_wj: !fixed_sigma,
+            grad_wl: false,
+        },
+    })?;
+    let missing = || RunError::Estimator("the block returned no gradient".into());
+    let gv = e.grad_v.as_ref().ok_or_else(missing)?;
+    let mut v_new = state.v.clone();
+    let mut w_new = state.w.clone();
+    let mut adam = state.adam.clone();
+    let (alpha, beta, guaranteed_v, below_noise_v) = match algorithm {
+        Algorithm::GpomdpConst { alpha, beta } => {
+            axpy(&mut v_new, alpha, &gv.value);
+            if let Some(gw) = &e.grad_wj {
+                axpy(&mut w_new, beta, &gw.value);
+            }
+            (alpha, beta, None, false)
+        }
+        Algorithm::GpomdpAdam {
+            lr_v,
+            lr_w,
+            beta1,
+            beta2,
+            epsilon,
+        } => {
+            let (mv, mw) = adam.get_or_insert_with(|| {
+                (
+                    AdamMoments::zeros(state.v.len()),
+                    AdamMoments::zeros(state.w.len()),
+                )
+            });
+            let dv = mv.step(&gv.value, lr_v, beta1, beta2, epsilon);
+            axpy(&mut v_new, 1.0, &dv);
+            if let Some(gw) = &e.grad_wj {
+                let dw = mw.step(&gw.value, lr_w, beta1, beta2, epsilon);
+                axpy(&mut w_new, 1.0, &dw);
+            }
+            (lr_v, lr_w, None, false)
+        }
+        _ => {
+            let sigma = state.w.iter().fold(f64::INFINITY, |m, &w| m.min(w.exp()));
+            match steps::ada_step(k, sigma, gv)? {
+                Some((alpha, guaranteed)) => {
+                    axpy(&mut v_new, alpha, &gv.value);
+                    (alpha, 0.0, Some(guaranteed), false)
+                }
+                None => (0.0, 0.0, None, true),
+            }
+        }
+    };
+    if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
+        return Err(RunError::NonFinite {
+            what: "policy parameters",
+            iteration: t,
+        });
+    }
+    let mut budget = state.budget;
+    if let Some(p) = state.pending {
+        budget += e.j - p;
+    }
+    let record = Record {
+        iteration: t,
+        v: state.v.clone(),
+        w: state.w.clone(),
+        sigma: state.sigma(),
+        j_exploratory: e.j,
+        j_after_v: None,
+        j_target: e.j,
+        w_target: Some(state.w.clone()),
+        budget,
+        required_v: None,
+        required_w: None,
+        alpha,
+        beta,
+        lambda_v: None,
+        lambda_w: None,
+        guaranteed_v,
+        guaranteed_w: None,
+        infeasible_v: false,
+        infeasible_w: false,
+        below_noise_v,
+        below_noise_w: false,
+        trajectories: state.trajectories + e.trajectories,
+        steps: state.steps + e.steps,
+    };
+    state.iteration += 1;
+    state.v = v_new;
+    state.w = w_new;
+    state.adam = adam;
+    state.budget = budget;
+    state.j0.get_or_insert(e.j);
+    state.pending = Some(e.j);
+    state.trajectories = record.trajectories;
+    state.steps = record.steps;
+    Ok(record)
+}
+
+fn axpy(x: &mut [f64], a: f64, y: &[f64]) {
+    for (xi, yi) in x.iter_mut().zip(y) {
+        *xi += a * yi;
+    }
+}

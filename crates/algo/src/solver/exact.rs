@@ -1,0 +1,59 @@
+//! Exact J and gradients from an oracle of `sepg_mdp::oracle` (the setting of Sec 4.3).
+use sepg_bounds::constants::TaskConstants;
+use sepg_mdp::oracle::{ExactOracle, Exploration, Horizon};
+
+use crate::core::error::RunError;
+use crate::solver::source::{Estimate, Grad, GradientSource, Query};
+use crate::solver::steps;
+
+/// A [`GradientSource`] backed by an exact oracle: no trajectories, ε = 0.
+pub(crate) struct ExactSource {
+    oracle: Box<dyn ExactOracle + Send>,
+    horizon: Horizon,
+    constants: TaskConstants,
+}
+
+impl ExactSource {
+    pub(crate) fn new(
+        oracle: Box<dyn ExactOracle + Send>,
+        horizon: Horizon,
+        constants: TaskConstants,
+    ) -> Self {
+        ExactSource {
+            oracle,
+            horizon,
+            constants,
+        }
+    }
+}
+
+impl GradientSource for ExactSource {
+    fn estimate(&mut self, q: &Query<'_>) -> Result<Estimate, RunError> {
+        let exploration = match q.w {
+            Some(w) => Exploration::Gaussian { w: w.to_vec() },
+            None => Exploration::Deterministic,
+        };
+        let e = self
+            .oracle
+            .evaluate(q.v, &exploration, self.horizon)
+            .map_err(|err| RunError::Mdp(err.to_string()))?;
+        let grad_wl = if q.need.grad_wl {
+            Some(Grad::exact(steps::surrogate_grad_w(
+                &self.constants,
+                &e.grad_v,
+                &e.mixed_wv,
+                &e.sigma,
+            )?))
+        } else {
+            None
+        };
+        Ok(Estimate {
+            j: e.j,
+            grad_v: q.need.grad_v.then(|| Grad::exact(e.grad_v.clone())),
+            grad_wj: q.need.grad_wj.then(|| Grad::exact(e.grad_w.clone())),
+            grad_wl,
+            trajectories: 0,
+            steps: 0,
+        })
+    }
+}

@@ -1,0 +1,275 @@
+//! One iteration of SEPG (Algorithm 4.3 with the delayed budget updates of Sec 4.4.4).
+use crate::core::config::Requirement;
+use crate::core::error::RunError;
+use crate::core::record::Record;
+use crate::core::seed::Block;
+use crate::core::state::State;
+use sepg_bounds::budget::split_requirement;
+use sepg_bounds::constants::TaskConstants;
+
+use crate::solver::source::{Estimate, GradientSource, Need, Query};
+use crate::solver::steps::{self, Plan};
+
+/// Trajectories of each block: `n` split evenly, the remainder going to the first blocks.
+pub(crate) fn split(n: usize, blocks: usize) -> Vec<usize> {
+    (0..blocks)
+        .map(|b| n / blocks + usize::from(b < n % blocks))
+        .collect()
+}
+
+/// Fields of a [`Record`] produced by one update block.
+#[derive(Debug, Clone, Copy, Default)]
+struct BlockLog {
+    size: f64,
+    lambda: Option<f64>,
+    guaranteed: Option<f64>,
+    infeasible: bool,
+    below_noise: bool,
+}
+
+impl BlockLog {
+    fn from_plan(plan: &Plan) -> Self {
+        match plan {
+            Plan::BelowNoise => BlockLog {
+                below_noise: true,
+                ..BlockLog::default()
+            },
+            Plan::Update(s) => BlockLog {
+                size: s.size,
+                lambda: s.lambda,
+                guaranteed: Some(s.guaranteed),
+                infeasible: s.infeasible,
+                below_noise: false,
+            },
+        }
+    }
+}
+
+fn apply(x: &mut [f64], plan: &Plan) {
+    if let Plan::Update(s) = plan {
+        x[s.index] += s.delta;
+    }
+}
+
+fn min_sigma(w: &[f64]) -> f64 {
+    w.iter().fold(f64::INFINITY, |m, &wi| m.min(wi.exp()))
+}
+
+/// Runs SEPG iteration `state.iteration` for `req`; `naive_w` selects the w-update along
+/// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20).
+pub(crate) fn iterate(
+    source: &mut dyn GradientSource,
+    k: &TaskConstants,
+    req: Requirement,
+    naive_w: bool,
+    n: usize,
+    state: &mut State,
+) -> Result<Record, RunError> {
+    let t = state.iteration;
+    let sizes = split(n, req.blocks());
+    let mut budget = state.budget;
+    let mut j0 = state.j0;
+    let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
+    let w_dir = Need {
+        grad_v: false,
+        grad_wj: true,
+        grad_wl: !naive_w,
+    };
+    let sim_nu = match req {
+        Requirement::Sim { nu } => Some(nu),
+        _ => None,
+    };
+    let sim = sim_nu.is_some();
+
+    // v-block: J(vᵗ, wᵗ) and ∇_v J (plus the w-gradients SIM-ν and LV need from this batch).
+    let need_v = Need {
+        grad_v: true,
+        grad_wj: sim || req == Requirement::Lv,
+        grad_wl: sim && !naive_w,
+    };
+    let ev = source.estimate(&Query {
+        iteration: t,
+        block: Block::V,
+        v: &state.v,
+        w: Some(&state.w),
+        n: sizes[0],
+        need: need_v,
+    })?;
+    trajectories += ev.trajectories;
+    env_steps += ev.steps;
+    let j_t = ev.j;
+    let j_base = *j0.get_or_insert(j_t);
+    // Delayed w-budget update of the previous iteration (Sec 4.4.4).
+    if let Some(p) = state.pending {
+        budget += j_t - p;
+    }
+
+    let sigmas = state.sigma();
+    let sigma = min_sigma(&state.w);
+    // Type-I requirement Cᵗ (Table 4.1) split (1 − ν)C / νC (eqs. 4.13, 4.14); SIM-ν splits
+    // the budget νB / (1 − ν)B (Sec 5.1.3); other type-II updates use C = −B.
+    let type_one = match req {
+        Requirement::Mi => Some(split_requirement(0.0, 0.0)),
+        Requirement::LbI { nu } => Some(split_requirement(j_base - j_t, nu)),
+        _ => None,
+    }
+    .transpose()
+    .map_err(|e| RunError::Bounds(e.to_string()))?;
+    let required_v = match (type_one, sim_nu) {
+        (Some((cv, _)), _) => cv,
+        (None, Some(nu)) => -nu * budget,
+        (None, None) => -budget,
+    };
+    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
+        "the v-block returned no gradient".into(),
+    ))?;
+    let v_plan = steps::v_step(k, sigma, grad_v, required_v)?;
+    let v_log = BlockLog::from_plan(&v_plan);
+    let mut v_new = state.v.clone();
+    apply(&mut v_new, &v_plan);
+
+    // Target block (LV, ZV, SIM-ν): evaluate θ_Tᵗ = (vᵗ, w_T) and update the budget (line 12).
+    let mut w_target = Some(state.w.clone());
+    let mut j_target = j_t;
+    if matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    ) {
+        w_target = if req == Requirement::Lv {
+            let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
+                "the v-block returned no w-gradient".into(),
+            ))?;
+            let mut wt = state.w.clone();
+            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, -budget)? {
+                wt[h] += dw;
+            }
+            Some(wt)
+        } else {
+            None
+        };
+        let et = source.estimate(&Query {
+            iteration: t,
+            block: Block::Target,
+            v: &state.v,
+            w: w_target.as_deref(),
+            n: sizes[1],
+            need: Need::default(),
+        })?;
+        trajectories += et.trajectories;
+        env_steps += et.steps;
+        j_target = et.j;
+        if let Some(prev) = state.target_prev {
+            budget += j_target - prev;
+        }
+    }
+
+    // w-block.
+    let mut w_new = state.w.clone();
+    let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
+        let required_w = -(1.0 - nu) * budget;
+        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w)?;
+        apply(&mut w_new, &plan);
+        (None, required_w, BlockLog::from_plan(&plan), j_t)
+    } else {
+        let ew = source.estimate(&Query {
+            iteration: t,
+            block: Block::W,
+            v: &v_new,
+            w: Some(&state.w),
+            n: sizes[sizes.len() - 1],
+            need: w_dir,
+        })?;
+        trajectories += ew.trajectories;
+        env_steps += ew.steps;
+        // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
+        budget += ew.j - j_t;
+        let required_w = type_one.map_or(-budget, |(_, cw)| cw);
+        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w)?;
+        apply(&mut w_new, &plan);
+        (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
+    };
+
+    if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
+        return Err(RunError::NonFinite {
+            what: "policy parameters",
+            iteration: t,
+        });
+    }
+    if !budget.is_finite() {
+        return Err(RunError::NonFinite {
+            what: "budget",
+            iteration: t,
+        });
+    }
+
+    let record = Record {
+        iteration: t,
+        v: state.v.clone(),
+        w: state.w.clone(),
+        sigma: sigmas,
+        j_exploratory: j_t,
+        j_after_v,
+        j_target,
+        w_target,
+        budget,
+        required_v: Some(required_v),
+        required_w: Some(required_w),
+        alpha: v_log.size,
+        beta: w_log.size,
+        lambda_v: v_log.lambda,
+        lambda_w: w_log.lambda,
+        guaranteed_v: v_log.guaranteed,
+        guaranteed_w: w_log.guaranteed,
+        infeasible_v: v_log.infeasible,
+        infeasible_w: w_log.infeasible,
+        below_noise_v: v_log.below_noise,
+        below_noise_w: w_log.below_noise,
+        trajectories,
+        steps: env_steps,
+    };
+    state.iteration += 1;
+    state.v = v_new;
+    state.w = w_new;
+    state.budget = budget;
+    state.j0 = j0;
+    state.pending = Some(pending);
+    if matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    ) {
+        state.target_prev = Some(j_target);
+    }
+    state.trajectories = trajectories;
+    state.steps = env_steps;
+    Ok(record)
+}
+
+/// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `naive`).
+fn w_plan(
+    k: &TaskConstants,
+    sigmas: &[f64],
+    e: &Estimate,
+    required: f64,
+    naive: bool,
+) -> Result<Plan, RunError> {
+    let missing = || RunError::Estimator("the w-block returned no w-gradient".into());
+    let gj = e.grad_wj.as_ref().ok_or_else(missing)?;
+    if naive {
+        steps::w_step_naive(k, sigmas, gj, required)
+    } else {
+        let gl = e.grad_wl.as_ref().ok_or_else(missing)?;
+        steps::w_step_surrogate(k, sigmas, gl, gj, required)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split;
+
+    #[test]
+    fn split_is_even_with_remainder_first() {
+        assert_eq!(split(100, 3), vec![34, 33, 33]);
+        assert_eq!(split(100, 2), vec![50, 50]);
+        assert_eq!(split(7, 1), vec![7]);
+    }
+}

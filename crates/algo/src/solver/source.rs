@@ -1,0 +1,73 @@
+//! Where J and its gradients come from: Monte Carlo estimates or exact oracles. The iteration
+//! logic is written once against [`GradientSource`].
+use crate::core::error::RunError;
+use crate::core::seed::Block;
+
+/// A gradient with its per-component confidence half-widths ε_i (Assumption 4.6); all
+/// widths are 0 for exact gradients.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Grad {
+    /// The (estimated) gradient components.
+    pub value: Vec<f64>,
+    /// Half-widths ε_i, same length as `value`.
+    pub eps: Vec<f64>,
+}
+
+impl Grad {
+    /// An exact gradient (ε = 0).
+    pub fn exact(value: Vec<f64>) -> Self {
+        let eps = vec![0.0; value.len()];
+        Grad { value, eps }
+    }
+}
+
+/// Which gradients a block needs besides J.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Need {
+    /// ∇_v J.
+    pub grad_v: bool,
+    /// ∇_w J.
+    pub grad_wj: bool,
+    /// ∇_w L (surrogate of Corollary 4.4).
+    pub grad_wl: bool,
+}
+
+/// One evaluation of a policy by a block.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Query<'a> {
+    /// Iteration the block belongs to (seeds the trajectories).
+    pub iteration: u64,
+    /// Which block (seeds the trajectories).
+    pub block: Block,
+    /// Mean parameters.
+    pub v: &'a [f64],
+    /// Log standard deviations, `None` for the deterministic policy (w = −∞).
+    pub w: Option<&'a [f64]>,
+    /// Number of trajectories of the block (ignored by exact sources).
+    pub n: usize,
+    /// Gradients requested.
+    pub need: Need,
+}
+
+/// The result of a [`Query`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Estimate {
+    /// J(θ) (Ĵ, the mean discounted return, when sampled).
+    pub j: f64,
+    /// ∇_v J if requested.
+    pub grad_v: Option<Grad>,
+    /// ∇_w J if requested.
+    pub grad_wj: Option<Grad>,
+    /// ∇_w L if requested.
+    pub grad_wl: Option<Grad>,
+    /// Trajectories used.
+    pub trajectories: u64,
+    /// Environment steps used.
+    pub steps: u64,
+}
+
+/// A provider of J and its gradients.
+pub(crate) trait GradientSource: Send {
+    /// Evaluates the policy of `q`.
+    fn estimate(&mut self, q: &Query<'_>) -> Result<Estimate, RunError>;
+}

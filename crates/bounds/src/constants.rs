@@ -1,0 +1,220 @@
+//! Task constants and the penalty coefficients `c` (Theorems 3.14 / 4.2) and `d` (Theorem 4.3).
+
+use crate::error::{BoundsError, finite, no_overflow, positive};
+
+/// √(2π).
+const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
+
+/// The constants of a task that enter every closed-form bound, validated once.
+///
+/// Build it with [`TaskConstants::new`]; only validated constants can reach the bounds
+/// (Section 4.3.1 and SPEC §1).
+///
+/// - `gamma`: discount factor γ ∈ [0, 1);
+/// - `r_max`: R, the largest absolute reward, R > 0;
+/// - `m_phi`: M_φ, the bound on every feature, |φ_i(s)| ≤ M_φ (eq. (3.14)), M_φ > 0;
+/// - `action_volume`: |A|, the volume of the action space, |A| > 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TaskConstants {
+    gamma: f64,
+    r_max: f64,
+    m_phi: f64,
+    action_volume: f64,
+}
+
+impl TaskConstants {
+    /// Validates the task constants.
+    ///
+    /// Errors: any input non-finite, γ ∉ [0, 1), or R, M_φ, |A| not strictly positive.
+    ///
+    /// ```
+    /// use sepg_bounds::constants::TaskConstants;
+    /// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
+    /// assert_eq!(k.gamma(), 0.99);
+    /// assert!(TaskConstants::new(1.0, 4.0, 2.0, 4.0).is_err());
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn new(
+        gamma: f64,
+        r_max: f64,
+        m_phi: f64,
+        action_volume: f64,
+    ) -> Result<Self, BoundsError> {
+        finite("gamma", gamma)?;
+        if !(0.0..1.0).contains(&gamma) {
+            return Err(BoundsError::OutOfDomain {
+                name: "gamma",
+                value: gamma,
+                domain: "[0, 1)",
+            });
+        }
+        Ok(Self {
+            gamma,
+            r_max: positive("r_max", r_max)?,
+            m_phi: positive("m_phi", m_phi)?,
+            action_volume: positive("action_volume", action_volume)?,
+        })
+    }
+
+    /// The discount factor γ ∈ [0, 1).
+    ///
+    /// ```
+    /// # use sepg_bounds::constants::TaskConstants;
+    /// assert_eq!(TaskConstants::new(0.9, 1.0, 1.0, 2.0)?.gamma(), 0.9);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn gamma(&self) -> f64 {
+        self.gamma
+    }
+
+    /// R, the largest absolute reward (> 0).
+    ///
+    /// ```
+    /// # use sepg_bounds::constants::TaskConstants;
+    /// assert_eq!(TaskConstants::new(0.9, 1.5, 1.0, 2.0)?.r_max(), 1.5);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn r_max(&self) -> f64 {
+        self.r_max
+    }
+
+    /// M_φ, the uniform bound on the features (> 0), eq. (3.14).
+    ///
+    /// ```
+    /// # use sepg_bounds::constants::TaskConstants;
+    /// assert_eq!(TaskConstants::new(0.9, 1.0, 3.0, 2.0)?.m_phi(), 3.0);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn m_phi(&self) -> f64 {
+        self.m_phi
+    }
+
+    /// |A|, the volume of the action space (> 0).
+    ///
+    /// ```
+    /// # use sepg_bounds::constants::TaskConstants;
+    /// assert_eq!(TaskConstants::new(0.9, 1.0, 1.0, 8.0)?.action_volume(), 8.0);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn action_volume(&self) -> f64 {
+        self.action_volume
+    }
+}
+
+/// ψ of Lemma A.1: the largest value of |∂²π/∂w²| · σ over actions.
+///
+/// # Formula
+///
+/// ```text
+/// ψ = max_{χ ≥ 0} |(χ² − 4χ + 1) e^{−χ/2}| / √(2π)
+///   = 4 (√7 − 2) e^{√7/2 − 2} / √(2π)  ≈ 0.523 557
+/// ```
+///
+/// The maximum of |f(χ)| = |(χ² − 4χ + 1)e^{−χ/2}| on χ ≥ 0 is attained at the stationary point
+/// χ₂ = 4 − √7, where f(χ₂) = −4(√7 − 2)e^{√7/2 − 2} ≈ −1.31236 (the other stationary point
+/// χ₁ = 4 + √7 gives f(χ₁) = 4(√7 + 2)e^{−√7/2 − 2} ≈ 0.66990, and f(0) = 1).
+/// Dimensionless.
+///
+/// ```
+/// let psi = sepg_bounds::constants::psi();
+/// assert!((psi - 0.523_557_020_321_374).abs() < 1e-15);
+/// ```
+pub fn psi() -> f64 {
+    let s7 = 7.0_f64.sqrt();
+    4.0 * (s7 - 2.0) * (s7 / 2.0 - 2.0).exp() / SQRT_2PI
+}
+
+/// The penalty coefficient `c` of the mean-parameter bound (Theorem 3.14 / Theorem 4.2).
+///
+/// # Formula
+///
+/// ```text
+/// c(σ) = R M_φ² / ((1 − γ)² σ²) · ( |A| / (√(2π) σ) + γ / (2 (1 − γ)) )
+/// ```
+///
+/// Domain: σ > 0 (standard deviation of the Gaussian policy, action units). Units of
+/// R / (action)², so that c‖Δv‖² is a performance. Strictly decreasing in σ.
+///
+/// Errors: σ not finite and positive; overflow (σ extremely small).
+///
+/// ```
+/// use sepg_bounds::constants::{TaskConstants, c};
+/// let k = TaskConstants::new(0.5, 1.0, 1.0, 1.0)?;
+/// // R M²/((1-γ)²σ²) = 4, bracket = 1/√(2π) + 0.5
+/// let expected = 4.0 * (1.0 / (2.0 * std::f64::consts::PI).sqrt() + 0.5);
+/// assert!((c(&k, 1.0)? - expected).abs() < 1e-14);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn c(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
+    positive("sigma", sigma)?;
+    let g = k.gamma;
+    let one_minus = 1.0 - g;
+    let front = k.r_max * k.m_phi * k.m_phi / (one_minus * one_minus);
+    let bracket_over_sigma2 = k.action_volume / (SQRT_2PI * sigma * sigma * sigma)
+        + g / (2.0 * one_minus * sigma * sigma);
+    no_overflow("c", front * bracket_over_sigma2)
+}
+
+/// The analytic derivative ∂c/∂σ of [`c`] (used by the surrogate gradient of Appendix B).
+///
+/// # Formula
+///
+/// ```text
+/// ∂c/∂σ = R M_φ² / (1 − γ)² · ( −3 |A| / (√(2π) σ⁴) − γ / ((1 − γ) σ³) )
+/// ```
+///
+/// Domain: σ > 0. Always strictly negative.
+///
+/// ```
+/// use sepg_bounds::constants::{TaskConstants, c, dc_dsigma};
+/// let k = TaskConstants::new(0.9, 2.0, 1.5, 3.0)?;
+/// let h = 1e-6;
+/// let fd = (c(&k, 0.7 + h)? - c(&k, 0.7 - h)?) / (2.0 * h);
+/// assert!((dc_dsigma(&k, 0.7)? - fd).abs() < 1e-6 * fd.abs());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn dc_dsigma(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
+    positive("sigma", sigma)?;
+    let g = k.gamma;
+    let one_minus = 1.0 - g;
+    let front = k.r_max * k.m_phi * k.m_phi / (one_minus * one_minus);
+    let s3 = sigma * sigma * sigma;
+    let bracket = -3.0 * k.action_volume / (SQRT_2PI * s3 * sigma) - g / (one_minus * s3);
+    no_overflow("dc/dsigma", front * bracket)
+}
+
+/// The penalty coefficient `d` of the variance-parameter bound (Theorem 4.3, eq. (4.15)).
+///
+/// # Formula
+///
+/// ```text
+/// d(σ) = R / (1 − γ)² · ( ψ |A| / (2σ) + γ / (1 − γ) ),   ψ = psi()
+/// ```
+///
+/// Domain: σ > 0 is the standard deviation *before* the w-update (σ = e^w). Units of R per
+/// (log-σ)², so that dΔw² is a performance. Strictly decreasing in σ.
+///
+/// ```
+/// use sepg_bounds::constants::{TaskConstants, d, psi};
+/// let k = TaskConstants::new(0.0, 1.0, 1.0, 2.0)?;
+/// assert!((d(&k, 1.0)? - psi()).abs() < 1e-15);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn d(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
+    positive("sigma", sigma)?;
+    let one_minus = 1.0 - k.gamma;
+    let front = k.r_max / (one_minus * one_minus);
+    let bracket = psi() * k.action_volume / (2.0 * sigma) + k.gamma / one_minus;
+    no_overflow("d", front * bracket)
+}
+
+/// The two coefficients of the rigorous w-bound (module [`crate::rigorous`]):
+/// `(a, g)` with a = R ψ |A| / (2 (1 − γ)² σ) and g = γ R / (2 (1 − γ)³), so that
+/// d(σ) = a + 2g.
+pub(crate) fn d_parts(k: &TaskConstants, sigma: f64) -> Result<(f64, f64), BoundsError> {
+    positive("sigma", sigma)?;
+    let one_minus = 1.0 - k.gamma;
+    let a = k.r_max * psi() * k.action_volume / (2.0 * one_minus * one_minus * sigma);
+    let g = k.gamma * k.r_max / (2.0 * one_minus * one_minus * one_minus);
+    Ok((no_overflow("d", a)?, no_overflow("d", g)?))
+}

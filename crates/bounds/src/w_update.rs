@@ -1,0 +1,217 @@
+//! The variance-parameter update w ← w + β·(direction), Theorems 4.3 and 4.5
+//! (eqs. (4.15)–(4.19)), in the thesis form that neglects O(Δw³) terms. The rigorous
+//! counterpart is in [`crate::rigorous`].
+//!
+//! σ = e^w is the standard deviation *before* the update; `grad_w_j` is ∇_w J and `grad_w_l`
+//! is ∇_w L (the surrogate gradient of [`crate::surrogate`]), both at (v^{t+1}, w^t).
+
+use crate::constants::{TaskConstants, d};
+use crate::error::{BoundsError, finite, no_overflow};
+use crate::outcome::{StepOutcome, quadratic_c_max, solve_quadratic};
+
+/// β* = 1/(2d), the step of maximal guaranteed improvement along ∇_w J (Theorem 4.3).
+///
+/// # Formula
+///
+/// ```text
+/// β* = 1 / (2 d(σ))
+/// ```
+///
+/// ```
+/// use sepg_bounds::{constants::{TaskConstants, d}, w_update::beta_star};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert_eq!(beta_star(&k, 0.5)?, 0.5 / d(&k, 0.5)?);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
+    no_overflow("beta*", 0.5 / d(k, sigma)?)
+}
+
+/// The largest guaranteed improvement of the w-update, eq. (4.16) (also that of Theorem 4.5).
+///
+/// # Formula
+///
+/// ```text
+/// C_max^w = (∇_w J)² / (4 d(σ))
+/// ```
+///
+/// ```
+/// use sepg_bounds::{constants::{TaskConstants, d}, w_update::c_max};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert!((c_max(&k, 1.0, -2.0)? - 1.0 / d(&k, 1.0)?).abs() < 1e-15);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn c_max(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    quadratic_c_max(g2, d(k, sigma)? * g2)
+}
+
+/// The lower bound (4.15) for the step Δw = β ∇_w J.
+///
+/// # Formula
+///
+/// ```text
+/// B(β) = β (∇_w J)² − β² d(σ) (∇_w J)²
+/// ```
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, w_update::{beta_star, bound_along_j, c_max}};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let top = bound_along_j(&k, 1.0, 0.3, beta_star(&k, 1.0)?)?;
+/// assert!((top - c_max(&k, 1.0, 0.3)?).abs() < 1e-15);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn bound_along_j(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    beta: f64,
+) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("beta", beta)?;
+    let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    no_overflow(
+        "Theorem 4.3 bound",
+        beta * g2 - beta * beta * d(k, sigma)? * g2,
+    )
+}
+
+/// The safe steps along ∇_w J for a required improvement νC (Theorem 4.3, eq. (4.17)).
+///
+/// # Formula
+///
+/// ```text
+/// νC ≤ C_max^w:  λ_w = √(1 − νC / C_max^w),  β ∈ [β*(1 − λ_w), β*(1 + λ_w)]
+/// νC > C_max^w:  infeasible, best step β*
+/// ```
+///
+/// `required` is the improvement this update must guarantee (νC of (4.14)).
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = w_update::safe_step_along_j(&k, 1.0, 0.3, 0.0)?;
+/// let b = w_update::beta_star(&k, 1.0)?;
+/// assert!((o.chosen_step().unwrap() - 2.0 * b).abs() < 1e-12 * b);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn safe_step_along_j(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("required", required)?;
+    let dd = d(k, sigma)?;
+    let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    solve_quadratic(g2, dd * g2, required)
+}
+
+/// The lower bound of Theorem 4.5 for the step Δw = β ∇_w L (β of either sign).
+///
+/// # Formula
+///
+/// ```text
+/// B(β) = β ∇_w L ∇_w J − β² d(σ) (∇_w L)²
+/// ```
+///
+/// ```
+/// use sepg_bounds::{constants::{TaskConstants, d}, w_update::bound_along_l};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let value = bound_along_l(&k, 1.0, 0.3, -2.0, -0.1)?;
+/// let expected = 0.06 - 0.04 * d(&k, 1.0)?;
+/// assert!((value - expected).abs() < 1e-12 * expected.abs());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn bound_along_l(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    beta: f64,
+) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("beta", beta)?;
+    let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
+    let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
+    no_overflow(
+        "Theorem 4.5 bound",
+        beta * lj - beta * beta * d(k, sigma)? * l2,
+    )
+}
+
+/// β̃ = ∇_w J / (2 d ∇_w L), the step along ∇_w L of maximal guaranteed improvement
+/// (Theorem 4.5); negative when the two gradients disagree in sign.
+///
+/// # Formula
+///
+/// ```text
+/// β̃ = ∇_w J / (2 d(σ) ∇_w L)
+/// ```
+///
+/// Errors: ∇_w L = 0 (no direction to step along).
+///
+/// ```
+/// use sepg_bounds::{constants::{TaskConstants, d}, w_update::beta_tilde};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert!((beta_tilde(&k, 1.0, 0.3, -2.0)? + 0.075 / d(&k, 1.0)?).abs() < 1e-15);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn beta_tilde(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    if grad_w_l == 0.0 {
+        return Err(BoundsError::OutOfDomain {
+            name: "grad_w_l",
+            value: grad_w_l,
+            domain: "non-zero reals",
+        });
+    }
+    no_overflow("beta~", grad_w_j / (2.0 * d(k, sigma)? * grad_w_l))
+}
+
+/// The safe steps along ∇_w L for a required improvement νC (Theorem 4.5, eq. (4.19)).
+///
+/// # Formula
+///
+/// ```text
+/// νC ≤ C_max^w:  |β − β̃| ≤ λ_w |β̃|,  λ_w = √(1 − νC / C_max^w),
+///                largest β̄ = β̃ + λ_w |β̃|  (eq. (4.20))
+/// ```
+///
+/// With ∇_w L = 0 the outcome is [`StepOutcome::ZeroGradient`]. With ∇_w J = 0 ≠ ∇_w L,
+/// C_max = 0 and, for νC ≤ 0, the safe steps are |β| ≤ √(−νC / (d (∇_w L)²)) (λ undefined).
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, outcome::StepOutcome, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// // gradients of opposite sign and a budget to spend: the largest step follows ∇_w L
+/// let StepOutcome::Feasible(s) = w_update::safe_step_along_l(&k, 1.0, 0.3, -2.0, -0.1)? else {
+///     panic!("feasible")
+/// };
+/// assert!(s.vertex < 0.0 && s.largest() > 0.0);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn safe_step_along_l(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("required", required)?;
+    let dd = d(k, sigma)?;
+    let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
+    let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
+    solve_quadratic(lj, dd * l2, required)
+}

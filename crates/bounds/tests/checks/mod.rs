@@ -1,0 +1,9 @@
+mod batch_budget;
+mod common;
+mod errors;
+mod high_probability;
+mod intervals;
+mod optimal_steps;
+mod properties;
+mod psi_and_derivatives;
+mod rigorous;

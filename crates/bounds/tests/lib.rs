@@ -1,0 +1,3 @@
+//! Integration tests of `sepg-bounds`, compiled as a single binary.
+
+mod checks;

@@ -1,0 +1,9 @@
+//! Integration tests of sepg-estimators (one binary).
+mod coverage;
+mod hand;
+mod props;
+mod quantile_table;
+mod stability;
+mod support;
+mod unbiased;
+mod variance;

@@ -1,0 +1,121 @@
+//! Properties: estimators never return NaN for finite batches; the t-quantile is monotone.
+
+use proptest::prelude::*;
+use sepg_estimators::{
+    Baseline, BaselineFit, Estimate, Estimator, EstimatorError, GradientSpec, Kind, Param,
+    SurrogateEstimate, Width, student_t_quantile,
+};
+use sepg_mdp::Batch;
+
+/// A batch of the given shape whose entries are taken cyclically from `values`.
+fn batch_from(n: usize, h: usize, p: usize, l: usize, values: &[f64], sigma: f64) -> Batch {
+    let mut b = Batch::zeros(n, h, l * p, l, 0.9);
+    b.sigma.fill(sigma);
+    let mut it = values.iter().cycle();
+    for x in b
+        .disc_rewards
+        .iter_mut()
+        .chain(b.cum_score_v.iter_mut())
+        .chain(b.cum_score_w.iter_mut())
+    {
+        *x = *it.next().expect("non-empty");
+    }
+    b
+}
+
+fn all_finite(e: &Estimate) -> bool {
+    e.mean()
+        .iter()
+        .chain(e.samples())
+        .chain(e.variance())
+        .all(|x| x.is_finite())
+}
+
+/// Runs every estimator; each result must be finite, or a typed non-finite error when
+/// `allow_overflow`.
+fn check_all(b: &Batch, allow_overflow: bool) -> Result<(), TestCaseError> {
+    let mut est = Estimator::new();
+    let mut out = Estimate::new();
+    let ok = |r: Result<(), EstimatorError>, out: &Estimate| -> Result<(), TestCaseError> {
+        match r {
+            Ok(()) => prop_assert!(all_finite(out)),
+            Err(EstimatorError::NonFinite { .. }) if allow_overflow => {}
+            Err(e) => prop_assert!(false, "unexpected error {e}"),
+        }
+        Ok(())
+    };
+    for kind in [Kind::Reinforce, Kind::Gpomdp, Kind::Pgt] {
+        for baseline in [Baseline::None, Baseline::Mean, Baseline::Optimal] {
+            for fit in [BaselineFit::PlugIn, BaselineFit::LeaveOneOut] {
+                let s = GradientSpec {
+                    kind,
+                    baseline,
+                    fit,
+                };
+                for param in [Param::V, Param::W] {
+                    let r = est.gradient(b, param, s, &mut out);
+                    ok(r, &out)?;
+                    if r.is_ok() {
+                        let c = out.confidence(Width::StudentT, 0.05).unwrap();
+                        prop_assert!(c.eps.is_finite() && c.eps >= 0.0);
+                    }
+                }
+                let r = est.h(b, baseline, fit, &mut out);
+                ok(r, &out)?;
+                let r = est.mixed(b, s, &mut out);
+                ok(r, &out)?;
+                if b.n >= 4 {
+                    let mut sur = SurrogateEstimate::new();
+                    let dc = vec![-1.0; b.dim_w];
+                    let r = est.surrogate_gradient(b, s, 3.0, &dc, &mut sur);
+                    ok(r, sur.grad_w_l())?;
+                    if r.is_ok() {
+                        prop_assert!(sur.surrogate().is_finite());
+                    }
+                }
+            }
+        }
+    }
+    let r = est.value(b, &mut out);
+    ok(r, &out)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn moderate_batches_give_finite_estimates(
+        n in 2usize..7, h in 1usize..5, p in 1usize..3, l in 1usize..3,
+        values in prop::collection::vec(-1e3f64..1e3, 1..64),
+        sigma in 1e-3f64..1e3,
+    ) {
+        check_all(&batch_from(n, h, p, l, &values, sigma), false)?;
+    }
+
+    #[test]
+    fn extreme_batches_never_give_nan(
+        n in 2usize..6, h in 1usize..4,
+        values in prop::collection::vec(prop_oneof![
+            -1e300f64..1e300, -1e-300f64..1e-300, Just(0.0), Just(f64::MAX), Just(f64::MIN_POSITIVE)
+        ], 1..32),
+    ) {
+        check_all(&batch_from(n, h, 1, 1, &values, 1.0), true)?;
+    }
+
+    #[test]
+    fn t_quantile_is_monotone_in_p(p in 1e-6f64..0.999_999, f in 1e-3f64..1.0, nu in 1.0f64..1e9) {
+        let q = p + (1.0 - p) * f;
+        prop_assume!(q < 1.0);
+        let (a, b) = (student_t_quantile(p, nu).unwrap(), student_t_quantile(q, nu).unwrap());
+        prop_assert!(a < b, "t({p}, {nu}) = {a} >= t({q}, {nu}) = {b}");
+    }
+
+    #[test]
+    fn t_quantile_decreases_in_nu(p in 0.5001f64..0.999_999_9, nu in 1.0f64..1e8, f in 1e-3f64..10.0) {
+        let nu2 = nu * (1.0 + f);
+        let (a, b) = (student_t_quantile(p, nu).unwrap(), student_t_quantile(p, nu2).unwrap());
+        prop_assert!(a > b, "t({p}, {nu}) = {a} <= t({p}, {nu2}) = {b}");
+        // Odd in p − 1/2 (1 − p is exact for p ≥ 1/2).
+        prop_assert_eq!(student_t_quantile(1.0 - p, nu).unwrap(), -a);
+    }
+}

@@ -1,0 +1,760 @@
+//! The deterministic parallel rollout engine: trajectories into a [`Batch`] (discounted rewards
+//! and cumulative raw-action scores, Sec 2.3.1), or discounted returns only.
+//!
+//! Trajectory `i` of a batch draws only from its own streams `key.rngs(i)`
+//! ([`crate::rng::SeedKey`]), and every output value is written by exactly one trajectory, with
+//! no floating-point reduction across threads. The result is therefore bit-identical for any
+//! number of rayon threads. Work is split in fixed chunks of [`CHUNK`] trajectories.
+//!
+//! For a one-dimensional LQG ([`Environment::as_scalar_lqg`]) a fused scalar kernel runs
+//! instead of the generic one; both perform the same floating-point operations in the same
+//! order, so the kernel choice never changes a result.
+//!
+//! # Formula
+//! ```text
+//! disc_rewards[i, t] = γ^t r_t                              (0 for t ≥ len_i)
+//! cum_score_v[i, t]  = Σ_{k ≤ min(t, len_i − 1)} (a_k − μ(s_k)) φ(s_k) / σ²
+//! cum_score_w[i, t]  = Σ_{k ≤ min(t, len_i − 1)} ((a_k − μ(s_k))/σ)² − 1
+//! G_i                = Σ_t γ^t r_t
+//! ```
+//! where `a_k − μ(s_k) = σ z_k` is the raw (unclipped) Gaussian perturbation.
+
+use rayon::prelude::*;
+
+use crate::batch::Batch;
+use crate::env::{Environment, ScalarLqg};
+use crate::policy::GaussianPolicy;
+use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uniform};
+
+/// Number of trajectories in one parallel work item.
+pub const CHUNK: usize = 64;
+
+/// Errors of the rollout engine.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RolloutError {
+    /// `n = 0` or `horizon = 0`.
+    #[error("a batch needs n ≥ 1 trajectories and horizon ≥ 1 (got n = {n}, horizon = {horizon})")]
+    Empty {
+        /// Number of trajectories requested.
+        n: usize,
+        /// Horizon requested.
+        horizon: usize,
+    },
+    /// The policy's feature or action dimension does not match the environment's.
+    #[error("policy {what} dimension {found} does not match the environment's {expected}")]
+    DimensionMismatch {
+        /// `"feature"` or `"action"`.
+        what: &'static str,
+        /// Environment's dimension.
+        expected: usize,
+        /// Policy's dimension.
+        found: usize,
+    },
+    /// Scores were requested for the deterministic policy (they do not exist).
+    #[error("score rollouts need a stochastic policy (w > −∞)")]
+    DeterministicPolicy,
+    /// `n · horizon · dim_v` overflows `usize`.
+    #[error("the batch size overflows the address space")]
+    TooLarge,
+}
+
+/// Rolls out `n` trajectories of at most `horizon` steps with the stochastic `policy` and
+/// returns them as an estimator-ready [`Batch`] (Sec 2.3.1; layout and padding in
+/// [`crate::batch`]). Trajectory `i` uses the streams `key.rngs(i)`.
+///
+/// # Formula
+/// ```text
+/// s_0 ~ reset,  a_t = μ(s_t) + σ z_t,  (r_t, s_{t+1}) = step(s_t, a_t)
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::rollout};
+/// let env = LqgEnv::lqg1d();
+/// let pi = GaussianPolicy::scalar(-0.1, 0.0).unwrap();
+/// let b = rollout(&env, &pi, 100, 20, SeedKey::new(1, 0, 0)).unwrap();
+/// assert_eq!((b.n, b.horizon, b.steps()), (100, 20, 2000));
+/// ```
+pub fn rollout<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+) -> Result<Batch, RolloutError> {
+    let mut batch = Batch::zeros(0, 0, 0, 0, 0.0);
+    rollout_into(env, policy, n, horizon, key, &mut batch)?;
+    Ok(batch)
+}
+
+/// [`rollout`] into an existing [`Batch`], reusing its buffers (they are resized to the new
+/// shape, so they are not reallocated when the shape does not grow).
+///
+/// # Formula
+/// ```text
+/// same as rollout
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::{rollout, rollout_into}, Batch};
+/// let env = LqgEnv::lqg1d();
+/// let pi = GaussianPolicy::scalar(-0.1, 0.0).unwrap();
+/// let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
+/// rollout_into(&env, &pi, 10, 5, SeedKey::new(1, 0, 0), &mut b).unwrap();
+/// assert_eq!(b, rollout(&env, &pi, 10, 5, SeedKey::new(1, 0, 0)).unwrap());
+/// ```
+pub fn rollout_into<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+    batch: &mut Batch,
+) -> Result<(), RolloutError> {
+    check(env, policy, n, horizon)?;
+    let (sigma, inv_sigma) = policy.sigma_raw();
+    if policy.is_deterministic() {
+        return Err(RolloutError::DeterministicPolicy);
+    }
+    let dim_v = policy.dim_v();
+    let dim_w = policy.dim_w();
+    let cells = n.checked_mul(horizon).ok_or(RolloutError::TooLarge)?;
+    let cells_v = cells.checked_mul(dim_v).ok_or(RolloutError::TooLarge)?;
+    let cells_w = cells.checked_mul(dim_w).ok_or(RolloutError::TooLarge)?;
+    let gamma = env.constants().gamma;
+    batch.n = n;
+    batch.horizon = horizon;
+    batch.dim_v = dim_v;
+    batch.dim_w = dim_w;
+    batch.gamma = gamma;
+    batch.sigma.clear();
+    batch.sigma.extend_from_slice(sigma);
+    batch.disc_rewards.resize(cells, 0.0);
+    batch.cum_score_v.resize(cells_v, 0.0);
+    batch.cum_score_w.resize(cells_w, 0.0);
+    batch.lengths.resize(n, 0);
+    let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
+
+    if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
+        let pol = ScalarPolicy {
+            v: policy.v()[0],
+            sigma: sigma[0],
+            inv_sigma: inv_sigma[0],
+        };
+        fill_batch_scalar(batch, key, p, pol, limit);
+    } else {
+        let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
+        fill_batch(batch, key, dims, |rngs, rw, sv, sw, sc| {
+            generic_kernel::<E, true>(env, policy, gamma, limit, rngs, rw, sv, sw, sc).0
+        });
+    }
+    Ok(())
+}
+
+/// The discounted returns `G_i = Σ_t γ^t r_t` of `n` trajectories, without scores (the fast
+/// path for estimating `J`). Works with stochastic and deterministic policies; with the same
+/// key and a stochastic policy, `G_i` equals `rollout(..).discounted_return(i)` bit for bit.
+///
+/// # Formula
+/// ```text
+/// G_i = Σ_{t < len_i} γ^t r_t
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::{rollout, rollout_returns}};
+/// let env = LqgEnv::thesis();
+/// let pi = GaussianPolicy::scalar(-0.4, -1.0).unwrap();
+/// let key = SeedKey::new(5, 0, 0);
+/// let g = rollout_returns(&env, &pi, 8, 20, key).unwrap();
+/// assert_eq!(g[3], rollout(&env, &pi, 8, 20, key).unwrap().discounted_return(3));
+/// ```
+pub fn rollout_returns<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+) -> Result<Vec<f64>, RolloutError> {
+    let mut out = Vec::new();
+    rollout_returns_into(env, policy, n, horizon, key, &mut out)?;
+    Ok(out)
+}
+
+/// [`rollout_returns`] into an existing vector (resized to `n`).
+///
+/// # Formula
+/// ```text
+/// G_i = Σ_{t < len_i} γ^t r_t
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::rollout_returns_into};
+/// let mut g = Vec::new();
+/// let pi = GaussianPolicy::deterministic(vec![-0.5], 1, 1).unwrap();
+/// rollout_returns_into(&LqgEnv::thesis(), &pi, 4, 10, SeedKey::default(), &mut g).unwrap();
+/// assert!(g.iter().all(|x| *x <= 0.0));
+/// ```
+pub fn rollout_returns_into<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+    out: &mut Vec<f64>,
+) -> Result<(), RolloutError> {
+    check(env, policy, n, horizon)?;
+    out.resize(n, 0.0);
+    let gamma = env.constants().gamma;
+    let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
+    let (sigma, inv_sigma) = policy.sigma_raw();
+    if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
+        let v = policy.v()[0];
+        if policy.is_deterministic() {
+            let pol = ScalarPolicy {
+                v,
+                sigma: 0.0,
+                inv_sigma: 0.0,
+            };
+            fill_returns_scalar::<false>(out, key, p, pol, limit);
+        } else {
+            let pol = ScalarPolicy {
+                v,
+                sigma: sigma[0],
+                inv_sigma: inv_sigma[0],
+            };
+            fill_returns_scalar::<true>(out, key, p, pol, limit);
+        }
+    } else {
+        let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
+        fill_returns(out, key, dims, |rngs, sc| {
+            generic_kernel::<E, false>(
+                env,
+                policy,
+                gamma,
+                limit,
+                rngs,
+                &mut [],
+                &mut [],
+                &mut [],
+                sc,
+            )
+            .1
+        });
+    }
+    Ok(())
+}
+
+/// The Monte Carlo estimate `Ĵ = (1/n) Σ_i G_i` of the expected discounted return (eq. 2.1's
+/// `J(θ)` truncated at `horizon`), summed in trajectory order.
+///
+/// # Formula
+/// ```text
+/// Ĵ = (1/n) Σ_i Σ_t γ^t r_{i,t}
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::mean_return};
+/// let pi = GaussianPolicy::scalar(-0.6, -2.0).unwrap();
+/// let j = mean_return(&LqgEnv::thesis(), &pi, 1000, 20, SeedKey::default()).unwrap();
+/// assert!(j < 0.0 && j > -4.0 * 20.0);
+/// ```
+pub fn mean_return<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+) -> Result<f64, RolloutError> {
+    let g = rollout_returns(env, policy, n, horizon, key)?;
+    Ok(g.iter().sum::<f64>() / n as f64)
+}
+
+/// The Monte Carlo estimate of `J(v, −∞)`, the performance of the deterministic policy that
+/// acts the mean `μ(s)` of `policy` (Sec 4.3.1: `θ = [v | −∞]`).
+///
+/// # Formula
+/// ```text
+/// Ĵ(v, −∞) = (1/n) Σ_i Σ_t γ^t r(s_{i,t}, μ(s_{i,t}))
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, rollout::evaluate_mean_policy};
+/// let pi = GaussianPolicy::scalar(-0.6, 0.0).unwrap();
+/// let j = evaluate_mean_policy(&LqgEnv::thesis(), &pi, 1000, 20, SeedKey::default()).unwrap();
+/// assert!(j < 0.0);
+/// ```
+pub fn evaluate_mean_policy<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+) -> Result<f64, RolloutError> {
+    mean_return(env, &policy.to_deterministic(), n, horizon, key)
+}
+
+fn check<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+) -> Result<(), RolloutError> {
+    if n == 0 || horizon == 0 {
+        return Err(RolloutError::Empty { n, horizon });
+    }
+    for (what, expected, found) in [
+        ("feature", env.feature_dim(), policy.feature_dim()),
+        ("action", env.action_dim(), policy.action_dim()),
+    ] {
+        if expected != found {
+            return Err(RolloutError::DimensionMismatch {
+                what,
+                expected,
+                found,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Per-chunk work buffers of the generic kernel.
+struct Scratch {
+    state: Vec<f64>,
+    next: Vec<f64>,
+    phi: Vec<f64>,
+    action: Vec<f64>,
+    cum_v: Vec<f64>,
+    cum_w: Vec<f64>,
+}
+
+impl Scratch {
+    fn new((n, l, p): (usize, usize, usize)) -> Self {
+        Scratch {
+            state: vec![0.0; n],
+            next: vec![0.0; n],
+            phi: vec![0.0; p],
+            action: vec![0.0; l],
+            cum_v: vec![0.0; l * p],
+            cum_w: vec![0.0; l],
+        }
+    }
+}
+
+/// Runs `kernel` for every trajectory of `batch` in parallel chunks and pads each trajectory
+/// after its length (rewards 0, cumulative scores frozen).
+fn fill_batch<F>(batch: &mut Batch, key: SeedKey, dims: (usize, usize, usize), kernel: F)
+where
+    F: Fn(&mut TrajectoryRngs, &mut [f64], &mut [f64], &mut [f64], &mut Scratch) -> usize + Sync,
+{
+    let (h, dv, dw) = (batch.horizon, batch.dim_v, batch.dim_w);
+    let prefix = key.prefix();
+    batch
+        .disc_rewards
+        .par_chunks_mut(CHUNK * h)
+        .zip(batch.cum_score_v.par_chunks_mut(CHUNK * h * dv))
+        .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h * dw))
+        .zip(batch.lengths.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(c, (((rw, sv), sw), lens))| {
+            let mut scratch = Scratch::new(dims);
+            let trajectories = rw
+                .chunks_exact_mut(h)
+                .zip(sv.chunks_exact_mut(h * dv))
+                .zip(sw.chunks_exact_mut(h * dw))
+                .zip(lens.iter_mut());
+            for (k, (((r, v), w), len)) in trajectories.enumerate() {
+                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+                let l = kernel(&mut rngs, r, v, w, &mut scratch);
+                pad(r, v, dv, l);
+                pad_scores(w, dw, l);
+                *len = l;
+            }
+        });
+}
+
+/// Zero rewards from `len` on, freeze the v-scores at their last value.
+fn pad(rewards: &mut [f64], scores: &mut [f64], dim: usize, len: usize) {
+    rewards[len..].fill(0.0);
+    pad_scores(scores, dim, len);
+}
+
+fn pad_scores(scores: &mut [f64], dim: usize, len: usize) {
+    let (done, rest) = scores.split_at_mut(len * dim);
+    if rest.is_empty() {
+        return;
+    }
+    match done.len().checked_sub(dim) {
+        Some(last) => {
+            let last = &done[last..];
+            for row in rest.chunks_exact_mut(dim) {
+                row.copy_from_slice(last);
+            }
+        }
+        None => rest.fill(0.0),
+    }
+}
+
+/// Runs `kernel` for every trajectory in parallel chunks, storing its discounted return.
+fn fill_returns<F>(out: &mut [f64], key: SeedKey, dims: (usize, usize, usize), kernel: F)
+where
+    F: Fn(&mut TrajectoryRngs, &mut Scratch) -> f64 + Sync,
+{
+    let prefix = key.prefix();
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            let mut scratch = Scratch::new(dims);
+            for (k, g) in chunk.iter_mut().enumerate() {
+                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+                *g = kernel(&mut rngs, &mut scratch);
+            }
+        });
+}
+
+/// Trajectories advanced in lockstep by the fused scalar kernel. Each trajectory is a serial
+/// chain of dependent floating-point operations; interleaving independent trajectories lets
+/// the CPU overlap their latencies. The arithmetic of each trajectory is unchanged.
+const LANES: usize = 4;
+
+/// Mean gain and noise scale of a one-feature, one-action policy.
+#[derive(Clone, Copy)]
+struct ScalarPolicy {
+    v: f64,
+    sigma: f64,
+    inv_sigma: f64,
+}
+
+/// [`fill_batch`] for the scalar LQG, running the fused kernel on groups of [`LANES`]
+/// trajectories.
+fn fill_batch_scalar(
+    batch: &mut Batch,
+    key: SeedKey,
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+) {
+    let h = batch.horizon;
+    let prefix = key.prefix();
+    batch
+        .disc_rewards
+        .par_chunks_mut(CHUNK * h)
+        .zip(batch.cum_score_v.par_chunks_mut(CHUNK * h))
+        .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h))
+        .zip(batch.lengths.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(c, (((rw, sv), sw), lens))| {
+            let groups = rw
+                .chunks_mut(LANES * h)
+                .zip(sv.chunks_mut(LANES * h))
+                .zip(sw.chunks_mut(LANES * h))
+                .zip(lens.chunks_mut(LANES));
+            for (g, (((r, v), w), ls)) in groups.enumerate() {
+                let first = (c * CHUNK + g * LANES) as u64;
+                if ls.len() == LANES {
+                    scalar_group::<LANES>(p, pol, limit, prefix, first, r, v, w, h);
+                } else {
+                    for k in 0..ls.len() {
+                        let span = k * h..(k + 1) * h;
+                        let (rk, vk, wk) =
+                            (&mut r[span.clone()], &mut v[span.clone()], &mut w[span]);
+                        scalar_group::<1>(p, pol, limit, prefix, first + k as u64, rk, vk, wk, h);
+                    }
+                }
+                for (k, len) in ls.iter_mut().enumerate() {
+                    let span = k * h..(k + 1) * h;
+                    pad(&mut r[span.clone()], &mut v[span.clone()], 1, limit);
+                    pad_scores(&mut w[span], 1, limit);
+                    *len = limit;
+                }
+            }
+        });
+}
+
+/// Runs the scored scalar kernel on `K` consecutive trajectories whose rows are consecutive in
+/// `r`, `v`, `w` (each of length `K · h`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn scalar_group<const K: usize>(
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+    prefix: u64,
+    first: u64,
+    r: &mut [f64],
+    v: &mut [f64],
+    w: &mut [f64],
+    h: usize,
+) {
+    let mut rngs: [TrajectoryRngs; K] =
+        std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
+    scalar_kernel::<K, true, true>(p, pol, limit, &mut rngs, [r, v, w], h);
+}
+
+/// [`fill_returns`] for the scalar LQG (`STOCH = false`: the deterministic policy).
+fn fill_returns_scalar<const STOCH: bool>(
+    out: &mut [f64],
+    key: SeedKey,
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+) {
+    let prefix = key.prefix();
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            for (g, group) in chunk.chunks_mut(LANES).enumerate() {
+                let first = (c * CHUNK + g * LANES) as u64;
+                if group.len() == LANES {
+                    let mut rngs: [TrajectoryRngs; LANES] =
+                        std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
+                    group.copy_from_slice(&scalar_kernel::<LANES, false, STOCH>(
+                        p,
+                        pol,
+                        limit,
+                        &mut rngs,
+                        [&mut [], &mut [], &mut []],
+                        0,
+                    ));
+                } else {
+                    for (k, g) in group.iter_mut().enumerate() {
+                        let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
+                        let rows = [&mut [][..], &mut [], &mut []];
+                        *g = scalar_kernel::<1, false, STOCH>(p, pol, limit, &mut rngs, rows, 0)[0];
+                    }
+                }
+            }
+        });
+}
+
+/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep.
+/// `rows = [rewards, cum v-scores, cum w-scores]`, each holding the `K` trajectories' rows of
+/// length `h ≥ limit` back to back (written only when `SCORES`). `STOCH = false` is the
+/// deterministic policy (no draws from the policy stream). Returns the discounted returns.
+#[inline(always)]
+fn scalar_kernel<const K: usize, const SCORES: bool, const STOCH: bool>(
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+    rngs: &mut [TrajectoryRngs; K],
+    rows: [&mut [f64]; 3],
+    h: usize,
+) -> [f64; K] {
+    if p.clipping {
+        scalar_kernel_impl::<K, SCORES, STOCH, true>(p, pol, limit, rngs, rows, h)
+    } else {
+        scalar_kernel_impl::<K, SCORES, STOCH, false>(p, pol, limit, rngs, rows, h)
+    }
+}
+
+/// [`scalar_kernel`] with the clipping decided at compile time. Each step first draws the
+/// lanes' variates (policy stream, then environment stream, in the same per-stream order as
+/// the generic kernel), then runs the short branch-free arithmetic over the lanes.
+#[inline(always)]
+fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, const CLIP: bool>(
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+    rngs: &mut [TrajectoryRngs; K],
+    rows: [&mut [f64]; 3],
+    h: usize,
+) -> [f64; K] {
+    let p = *p;
+    let ScalarPolicy {
+        v,
+        sigma,
+        inv_sigma,
+    } = pol;
+    let noisy = p.noise_std > 0.0;
+    let mut s: [f64; K] =
+        std::array::from_fn(|k| uniform(&mut rngs[k].env, p.init_low, p.init_high));
+    let (mut cv, mut cw, mut ret) = ([0.0; K], [0.0; K], [0.0; K]);
+    let [rw, sv, sw] = rows;
+    let (rw, sv, sw, limit) = if SCORES {
+        let limit = limit.min(h);
+        (&mut rw[..K * h], &mut sv[..K * h], &mut sw[..K * h], limit)
+    } else {
+        (rw, sv, sw, limit)
+    };
+    let mut disc = 1.0;
+    let (mut z, mut eta) = ([0.0; K], [0.0; K]);
+    for t in 0..limit {
+        if STOCH {
+            for (zk, rng) in z.iter_mut().zip(rngs.iter_mut()) {
+                *zk = standard_normal(&mut rng.policy);
+            }
+        }
+        if noisy {
+            for (ek, rng) in eta.iter_mut().zip(rngs.iter_mut()) {
+                *ek = p.noise_std * standard_normal(&mut rng.env);
+            }
+        }
+        for k in 0..K {
+            let sk = s[k];
+            let mu = v * sk;
+            let a = if STOCH {
+                let zk = z[k];
+                if SCORES {
+                    cv[k] += zk * inv_sigma * sk;
+                    cw[k] += zk * zk - 1.0;
+                }
+                mu + sigma * zk
+            } else {
+                mu
+            };
+            let ac = if CLIP {
+                a.clamp(p.action_low, p.action_high)
+            } else {
+                a
+            };
+            let r = -(sk * (p.q * sk) + ac * (p.r * ac));
+            let dr = disc * r;
+            if SCORES {
+                rw[k * h + t] = dr;
+                sv[k * h + t] = cv[k];
+                sw[k * h + t] = cw[k];
+            }
+            ret[k] += dr;
+            let mut x = p.a * sk + p.b * ac;
+            if noisy {
+                x += eta[k];
+            }
+            s[k] = if CLIP {
+                x.clamp(p.state_low, p.state_high)
+            } else {
+                x
+            };
+        }
+        disc *= p.gamma;
+    }
+    ret
+}
+
+/// The generic kernel over any [`Environment`]. Returns `(len, G)`; stops after a terminal
+/// step.
+#[allow(clippy::too_many_arguments)]
+fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
+    env: &E,
+    policy: &GaussianPolicy,
+    gamma: f64,
+    limit: usize,
+    rngs: &mut TrajectoryRngs,
+    rewards: &mut [f64],
+    score_v: &mut [f64],
+    score_w: &mut [f64],
+    sc: &mut Scratch,
+) -> (usize, f64) {
+    let (sigma, inv_sigma) = policy.sigma_raw();
+    let stochastic = !policy.is_deterministic();
+    let p = policy.feature_dim();
+    let l = policy.action_dim();
+    let dv = l * p;
+    env.reset(&mut rngs.env, &mut sc.state);
+    sc.cum_v.fill(0.0);
+    sc.cum_w.fill(0.0);
+    let (mut disc, mut ret) = (1.0, 0.0);
+    for t in 0..limit {
+        env.features(&sc.state, &mut sc.phi);
+        for j in 0..l {
+            let mu = policy.mean_j(&sc.phi, j);
+            sc.action[j] = if stochastic {
+                let z = standard_normal(&mut rngs.policy);
+                if SCORES {
+                    let c = z * inv_sigma[j];
+                    for (cv, f) in sc.cum_v[j * p..(j + 1) * p].iter_mut().zip(&sc.phi) {
+                        *cv += c * f;
+                    }
+                    sc.cum_w[j] += z * z - 1.0;
+                }
+                mu + sigma[j] * z
+            } else {
+                mu
+            };
+        }
+        let (r, done) = env.step(&sc.state, &sc.action, &mut rngs.env, &mut sc.next);
+        let dr = disc * r;
+        if SCORES {
+            rewards[t] = dr;
+            score_v[t * dv..(t + 1) * dv].copy_from_slice(&sc.cum_v);
+            score_w[t * l..(t + 1) * l].copy_from_slice(&sc.cum_w);
+        }
+        ret += dr;
+        disc *= gamma;
+        std::mem::swap(&mut sc.state, &mut sc.next);
+        if done {
+            return (t + 1, ret);
+        }
+    }
+    (limit, ret)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::LqgEnv;
+    use crate::lqg_model::LqgModel;
+    use nalgebra::DVector;
+
+    /// The fused scalar kernel and the generic kernel agree bit for bit on every scalar LQG
+    /// variant (clipping on/off, noise on/off).
+    #[test]
+    fn scalar_kernel_matches_generic_kernel() {
+        let base = LqgModel::lqg1d();
+        let models = [
+            base.clone(),
+            base.clone().with_clipping(false),
+            base.clone()
+                .with_noise(DVector::from_element(1, 0.3))
+                .unwrap(),
+            base.with_noise(DVector::from_element(1, 0.3))
+                .unwrap()
+                .with_clipping(false),
+        ];
+        let pi = GaussianPolicy::scalar(-0.3, 0.4).unwrap();
+        let key = SeedKey::new(11, 2, 1);
+        let (n, h) = (70, 15);
+        for model in models {
+            let env = LqgEnv::new(model).unwrap();
+            let fast = rollout(&env, &pi, n, h, key).unwrap();
+            let mut slow = fast.clone();
+            let gamma = env.constants().gamma;
+            fill_batch(&mut slow, key, (1, 1, 1), |rngs, rw, sv, sw, sc| {
+                generic_kernel::<LqgEnv, true>(&env, &pi, gamma, h, rngs, rw, sv, sw, sc).0
+            });
+            assert_eq!(fast, slow);
+            let fast_g = rollout_returns(&env, &pi, n, h, key).unwrap();
+            let det = pi.to_deterministic();
+            let fast_det = rollout_returns(&env, &det, n, h, key).unwrap();
+            for i in 0..n {
+                let mut sc = Scratch::new((1, 1, 1));
+                let mut rngs = key.rngs(i as u64);
+                let g = generic_kernel::<LqgEnv, false>(
+                    &env,
+                    &pi,
+                    gamma,
+                    h,
+                    &mut rngs,
+                    &mut [],
+                    &mut [],
+                    &mut [],
+                    &mut sc,
+                )
+                .1;
+                assert_eq!(g.to_bits(), fast_g[i].to_bits());
+                let mut rngs = key.rngs(i as u64);
+                let g = generic_kernel::<LqgEnv, false>(
+                    &env,
+                    &det,
+                    gamma,
+                    h,
+                    &mut rngs,
+                    &mut [],
+                    &mut [],
+                    &mut [],
+                    &mut sc,
+                )
+                .1;
+                assert_eq!(g.to_bits(), fast_det[i].to_bits());
+            }
+        }
+    }
+}

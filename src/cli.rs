@@ -1,0 +1,101 @@
+//! Command-line definitions, error type and dispatch.
+//!
+//! Every failure is reported as one line on standard error, and nothing is printed on
+//! standard output. Bad input exits with status 2; a run that could not complete or a
+//! verification whose outcome changed exits with status 1.
+
+use std::fmt;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::commands;
+
+/// Exit status for bad input (unknown flag, malformed value, out-of-domain parameter).
+pub const EXIT_USAGE: u8 = 2;
+/// Exit status for a command that ran but failed (I/O error, changed verification outcome).
+pub const EXIT_FAILURE: u8 = 1;
+
+/// A command failure: the one-line message and the exit status it maps to.
+#[derive(Debug)]
+pub struct CliError {
+    code: u8,
+    message: String,
+}
+
+impl CliError {
+    /// Bad input: exit status 2.
+    pub fn usage(message: impl Into<String>) -> Self {
+        CliError { code: EXIT_USAGE, message: message.into() }
+    }
+
+    /// A failure while running: exit status 1.
+    pub fn failure(message: impl Into<String>) -> Self {
+        CliError { code: EXIT_FAILURE, message: message.into() }
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Keep the report on a single line whatever the underlying error printed.
+        let one_line = self.message.split_whitespace().collect::<Vec<_>>().join(" ");
+        f.write_str(&one_line)
+    }
+}
+
+/// Safely-Exploring Policy Gradient: closed-form safety bounds, exact LQG oracles, estimators,
+/// SEPG and a verification harness.
+#[derive(Debug, Parser)]
+#[command(name = "sepg", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Every closed-form safety quantity the given task constants and gradients determine.
+    Bounds(commands::bounds::BoundsArgs),
+    /// Check every statement of the thesis numerically and report the outcomes.
+    Verify(commands::verify::VerifyArgs),
+}
+
+/// Parses the command line, runs the command and maps failures to exit statuses.
+pub fn run() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            return match e.kind() {
+                ErrorKind::DisplayHelp
+                | ErrorKind::DisplayVersion
+                | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                        ExitCode::from(EXIT_USAGE)
+                    } else {
+                        ExitCode::SUCCESS
+                    }
+                }
+                _ => {
+                    let text = e.to_string();
+                    let first = text.lines().next().unwrap_or("invalid arguments");
+                    let first = first.trim_start_matches("error: ");
+                    eprintln!("sepg: error: {first}");
+                    ExitCode::from(EXIT_USAGE)
+                }
+            };
+        }
+    };
+    let result = match cli.command {
+        Command::Bounds(args) => commands::bounds::run(&args),
+        Command::Verify(args) => commands::verify::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sepg: error: {e}");
+            ExitCode::from(e.code)
+        }
+    }
+}

@@ -1,0 +1,279 @@
+//! `sepg bounds`: every closed-form quantity that the given task constants, σ and gradients
+//! determine (Theorems 3.11, 3.13, 3.14, 4.2, 4.3, 4.5, Lemma A.1, Corollary 4.4).
+
+use clap::Args;
+use serde::Serialize;
+use sepg_bounds::constants::{self, TaskConstants};
+use sepg_bounds::outcome::StepOutcome;
+use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
+
+use crate::cli::CliError;
+use crate::output::to_json_line;
+
+/// Arguments of `sepg bounds`.
+#[derive(Debug, Args)]
+pub struct BoundsArgs {
+    /// Discount factor γ ∈ [0, 1).
+    #[arg(long, allow_hyphen_values = true)]
+    gamma: f64,
+    /// Maximum absolute reward R (> 0).
+    #[arg(long = "r-max", allow_hyphen_values = true)]
+    r_max: f64,
+    /// Bound M_φ on every feature's absolute value (> 0).
+    #[arg(long = "m-phi", allow_hyphen_values = true)]
+    m_phi: f64,
+    /// Volume |A| of the action space (> 0).
+    #[arg(long = "action-volume", allow_hyphen_values = true)]
+    action_volume: f64,
+    /// Policy standard deviation σ = e^w (> 0).
+    #[arg(long, allow_hyphen_values = true)]
+    sigma: f64,
+    /// Number m of mean parameters (for the surrogate L = ‖∇_v J‖²/(4mc)); defaults to the
+    /// length of --grad-v.
+    #[arg(long = "dim-v")]
+    dim_v: Option<usize>,
+    /// Gradient ∇_v J, comma-separated (one value per mean parameter).
+    #[arg(long = "grad-v", value_delimiter = ',', allow_hyphen_values = true)]
+    grad_v: Option<Vec<f64>>,
+    /// Gradient ∇_w J (scalar).
+    #[arg(long = "grad-w", allow_hyphen_values = true)]
+    grad_w: Option<f64>,
+    /// Gradient ∇_w L of the surrogate (scalar); needs --grad-w.
+    #[arg(long = "grad-w-l", allow_hyphen_values = true)]
+    grad_w_l: Option<f64>,
+    /// Improvement C each update must guarantee (negative: a bounded worsening). Default 0.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    required: f64,
+    /// Split C between the updates as in (4.13)–(4.14): (1 − ν)C for v, νC for w.
+    /// Without it, each update must guarantee C.
+    #[arg(long, allow_hyphen_values = true)]
+    nu: Option<f64>,
+    /// Confidence δ ∈ (0, 1) for the Chebyshev batch sizes (with --eps and --horizon).
+    #[arg(long, allow_hyphen_values = true)]
+    delta: Option<f64>,
+    /// Gradient accuracy ε > 0 for the Chebyshev batch sizes.
+    #[arg(long, allow_hyphen_values = true)]
+    eps: Option<f64>,
+    /// Horizon H ≥ 1 for the Chebyshev batch sizes.
+    #[arg(long)]
+    horizon: Option<u32>,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Everything `sepg bounds` reports. Optional fields are absent when the inputs do not
+/// determine them.
+#[derive(Debug, Default, Serialize)]
+struct BoundsReport {
+    psi: f64,
+    c: f64,
+    d: f64,
+    dc_dsigma: f64,
+    alpha_star: f64,
+    beta_star: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    surrogate_coefficient: Option<f64>,
+    required_v: f64,
+    required_w: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    c_max_v: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    feasible_v: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lambda_v: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    alpha_interval: Option<[f64; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    alpha_bar: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    greedy_index: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    surrogate: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pirotta_alpha: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pirotta_guarantee: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    c_max_w: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    feasible_w: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lambda_w: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beta_interval_j: Option<[f64; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beta_bar_j: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beta_tilde: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beta_interval: Option<[f64; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beta_bar: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    batch_reinforce: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    batch_gpomdp: Option<u64>,
+}
+
+fn bad(e: BoundsError) -> CliError {
+    CliError::usage(e.to_string())
+}
+
+/// Fields describing a safe-step outcome: (feasible, λ, interval, chosen step).
+type OutcomeFields = (Option<bool>, Option<f64>, Option<[f64; 2]>, Option<f64>);
+
+fn outcome_fields(o: &StepOutcome) -> OutcomeFields {
+    match o {
+        StepOutcome::Feasible(s) => (Some(true), s.lambda, Some([s.lo, s.hi]), Some(s.hi)),
+        StepOutcome::Infeasible { vertex, .. } => (Some(false), None, None, Some(*vertex)),
+        StepOutcome::ZeroGradient { requirement_met } => (Some(*requirement_met), None, None, None),
+        StepOutcome::BelowNoise => (Some(false), None, None, None),
+    }
+}
+
+fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
+    let k = TaskConstants::new(a.gamma, a.r_max, a.m_phi, a.action_volume).map_err(bad)?;
+    let sigma = a.sigma;
+    let (required_v, required_w) = match a.nu {
+        Some(nu) => sepg_bounds::budget::split_requirement(a.required, nu).map_err(bad)?,
+        None => {
+            if !a.required.is_finite() {
+                return Err(CliError::usage(format!("required must be finite, got {}", a.required)));
+            }
+            (a.required, a.required)
+        }
+    };
+    let c = constants::c(&k, sigma).map_err(bad)?;
+    let mut r = BoundsReport {
+        psi: constants::psi(),
+        c,
+        d: constants::d(&k, sigma).map_err(bad)?,
+        dc_dsigma: constants::dc_dsigma(&k, sigma).map_err(bad)?,
+        alpha_star: v_update::alpha_star(&k, sigma).map_err(bad)?,
+        beta_star: w_update::beta_star(&k, sigma).map_err(bad)?,
+        required_v,
+        required_w,
+        ..BoundsReport::default()
+    };
+
+    let dim_v = match (&a.grad_v, a.dim_v) {
+        (Some(g), Some(m)) if g.len() != m => {
+            return Err(CliError::usage(format!(
+                "--dim-v {m} does not match the {} components of --grad-v",
+                g.len()
+            )));
+        }
+        (Some(g), _) => Some(g.len()),
+        (None, m) => m,
+    };
+    if let Some(m) = dim_v {
+        if m == 0 {
+            return Err(CliError::usage("--dim-v must be at least 1"));
+        }
+        r.surrogate_coefficient = Some(1.0 / (4.0 * m as f64 * c));
+    }
+
+    if let Some(g) = &a.grad_v {
+        r.c_max_v = Some(v_update::c_max(&k, sigma, g).map_err(bad)?);
+        let o = v_update::safe_step(&k, sigma, g, required_v).map_err(bad)?;
+        (r.feasible_v, r.lambda_v, r.alpha_interval, r.alpha_bar) = outcome_fields(&o);
+        r.greedy_index = Some(papini::greedy_step(&k, sigma, g).map_err(bad)?.index);
+        r.surrogate = Some(surrogate::surrogate(&k, sigma, g).map_err(bad)?);
+        if let pirotta::AdaptiveStep::Step { alpha, guarantee } =
+            pirotta::optimal_step(&k, sigma, g).map_err(bad)?
+        {
+            r.pirotta_alpha = Some(alpha);
+            r.pirotta_guarantee = Some(guarantee);
+        }
+    }
+
+    match (a.grad_w, a.grad_w_l) {
+        (None, Some(_)) => return Err(CliError::usage("--grad-w-l needs --grad-w")),
+        (Some(gj), gl) => {
+            r.c_max_w = Some(w_update::c_max(&k, sigma, gj).map_err(bad)?);
+            let oj = w_update::safe_step_along_j(&k, sigma, gj, required_w).map_err(bad)?;
+            let (feasible, lambda, interval, bar) = outcome_fields(&oj);
+            (r.feasible_w, r.lambda_w, r.beta_interval_j, r.beta_bar_j) =
+                (feasible, lambda, interval, bar);
+            if let Some(gl) = gl {
+                r.beta_tilde = Some(w_update::beta_tilde(&k, sigma, gj, gl).map_err(bad)?);
+                let ol = w_update::safe_step_along_l(&k, sigma, gj, gl, required_w).map_err(bad)?;
+                let (_, _, interval, bar) = outcome_fields(&ol);
+                (r.beta_interval, r.beta_bar) = (interval, bar);
+            }
+        }
+        (None, None) => {}
+    }
+
+    match (a.delta, a.eps, a.horizon) {
+        (Some(delta), Some(eps), Some(h)) => {
+            r.batch_reinforce = Some(batch_size::reinforce(&k, sigma, delta, eps, h).map_err(bad)?);
+            r.batch_gpomdp = Some(batch_size::gpomdp(&k, sigma, delta, eps, h).map_err(bad)?);
+        }
+        (None, None, None) => {}
+        _ => return Err(CliError::usage("batch sizes need all of --delta, --eps and --horizon")),
+    }
+    Ok(r)
+}
+
+fn fmt_opt(x: Option<f64>) -> String {
+    x.map_or_else(|| "-".to_string(), |v| format!("{v:.6e}"))
+}
+
+fn render_table(r: &BoundsReport) -> String {
+    let mut rows: Vec<(&str, String, &str)> = vec![
+        ("psi", format!("{:.10}", r.psi), "Lemma A.1"),
+        ("c", format!("{:.6e}", r.c), "Thm 4.2 (Papini et al. Thm 3.14)"),
+        ("d", format!("{:.6e}", r.d), "Thm 4.3"),
+        ("dc_dsigma", format!("{:.6e}", r.dc_dsigma), "Appendix B"),
+        ("alpha_star", format!("{:.6e}", r.alpha_star), "Thm 4.2: 1/(2c)"),
+        ("beta_star", format!("{:.6e}", r.beta_star), "Thm 4.3: 1/(2d)"),
+        ("required_v", format!("{:.6e}", r.required_v), "(4.13)"),
+        ("required_w", format!("{:.6e}", r.required_w), "(4.14)"),
+    ];
+    let opt_rows: [(&str, Option<f64>, &str); 13] = [
+        ("surrogate_coefficient", r.surrogate_coefficient, "Cor 4.4: 1/(4mc)"),
+        ("c_max_v", r.c_max_v, "(4.9)"),
+        ("lambda_v", r.lambda_v, "(4.10)"),
+        ("alpha_bar", r.alpha_bar, "(4.20): (1+lambda_v) alpha_star"),
+        ("surrogate", r.surrogate, "Cor 4.4: L"),
+        ("pirotta_alpha", r.pirotta_alpha, "Cor 3.11"),
+        ("pirotta_guarantee", r.pirotta_guarantee, "Cor 3.11"),
+        ("c_max_w", r.c_max_w, "(4.16)"),
+        ("lambda_w", r.lambda_w, "(4.17)"),
+        ("beta_bar_j", r.beta_bar_j, "(4.17): largest step along grad_w J"),
+        ("beta_tilde", r.beta_tilde, "Thm 4.5"),
+        ("beta_bar", r.beta_bar, "(4.20): beta_tilde + lambda_w |beta_tilde|"),
+        ("batch_gpomdp", r.batch_gpomdp.map(|n| n as f64), "Cor 3.13 (G(PO)MDP)"),
+    ];
+    for (name, value, cite) in opt_rows {
+        if value.is_some() {
+            rows.push((name, fmt_opt(value), cite));
+        }
+    }
+    if let Some(n) = r.batch_reinforce {
+        rows.push(("batch_reinforce", n.to_string(), "Cor 3.13 (REINFORCE, corrected)"));
+    }
+    if let Some(i) = r.greedy_index {
+        rows.push(("greedy_index", i.to_string(), "Thm 3.14: coordinate updated"));
+    }
+    for (name, feasible) in [("feasible_v", r.feasible_v), ("feasible_w", r.feasible_w)] {
+        if let Some(f) = feasible {
+            rows.push((name, f.to_string(), "C <= C_max"));
+        }
+    }
+    let mut out = String::new();
+    for (name, value, cite) in rows {
+        out.push_str(&format!("{name:<22} {value:>16}   {cite}\n"));
+    }
+    out
+}
+
+/// Runs `sepg bounds`.
+pub fn run(args: &BoundsArgs) -> Result<(), CliError> {
+    let report = compute(args)?;
+    let text = if args.json { to_json_line(&report)? } else { render_table(&report) };
+    print!("{text}");
+    Ok(())
+}

@@ -1,0 +1,4 @@
+//! One module per `sepg` subcommand.
+
+pub mod bounds;
+pub mod verify;

@@ -1,0 +1,20 @@
+//! # sepg — Safely-Exploring Policy Gradient with executable safety guarantees
+//!
+//! This facade re-exports the workspace crates so that a single dependency gives access to the
+//! whole toolkit:
+//!
+//! - [`bounds`]: every closed-form quantity of the thesis (ψ, c, d, α*, β̃, λ, C_max, batch
+//!   sizes, high-probability and rigorous variants, the budget of Theorem 4.1);
+//! - [`mdp`]: environments (LQG presets, n-D LQG, Mountain Car), the factored Gaussian linear
+//!   policy, the deterministic parallel rollout engine and the exact LQG oracles;
+//! - [`estimators`]: REINFORCE, G(PO)MDP, baselines, ∇_w L and confidence widths;
+//! - [`algo`]: SEPG with every safety requirement and the comparison algorithms;
+//! - [`verification`]: the registry of numerical checks of every theorem of the thesis.
+//!
+//! The `sepg` binary built from this package is the command-line interface.
+
+pub use sepg_algo as algo;
+pub use sepg_bounds as bounds;
+pub use sepg_estimators as estimators;
+pub use sepg_mdp as mdp;
+pub use sepg_verification as verification;

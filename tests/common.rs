@@ -1,0 +1,34 @@
+//! Helpers shared by the command-line tests.
+
+use std::process::{Command, Output};
+
+/// Runs the `sepg` binary with `args` and returns its output.
+pub fn sepg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(args)
+        .output()
+        .expect("the sepg binary runs")
+}
+
+/// Asserts the contract for bad input: exit status 2, nothing on standard output, exactly
+/// one non-empty line on standard error. Returns that line.
+pub fn assert_usage_error(out: &Output) -> String {
+    assert_eq!(out.status.code(), Some(2), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.stdout.is_empty(), "stdout must be empty, got {:?}", String::from_utf8_lossy(&out.stdout));
+    let err = String::from_utf8(out.stderr.clone()).expect("utf-8 stderr");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "exactly one line on stderr, got {err:?}");
+    assert!(!lines[0].trim().is_empty());
+    lines[0].to_string()
+}
+
+/// Parses standard output as one JSON object, asserting success.
+pub fn json_ok(out: &Output) -> serde_json::Value {
+    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON value")
+}
+
+/// Relative closeness with an absolute floor.
+pub fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
+}

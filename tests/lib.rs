@@ -1,0 +1,4 @@
+//! Integration tests of the `sepg` command-line interface, compiled into one binary.
+
+mod cli_bounds;
+mod common;

@@ -1,0 +1,354 @@
+//! Integration tests of the verification harness: determinism, fault injection, the
+//! Clopper–Pearson helper against a committed high-precision table, and the finite-MDP oracle
+//! against closed forms.
+
+use sepg_verification::finite_mdp::{FiniteMdp, MdpError, TabularPolicy};
+use sepg_verification::stats::{StatsError, clopper_pearson_lower, clopper_pearson_upper};
+use sepg_verification::{BoundFns, Outcome, RunConfig, derive_seed, registry, run_checks};
+
+/// Pinned outputs of `derive_seed` (value-stability).
+const PINNED_0: u64 = 0x593d_771d_1f41_4334;
+const PINNED_42: u64 = 0xd61f_c146_e22e_15d4;
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+}
+
+#[test]
+fn report_is_byte_identical_across_runs_and_thread_counts() {
+    let config = RunConfig {
+        seed: 7,
+        quick: true,
+    };
+    let checks = registry();
+    let one = pool(1).install(|| run_checks(&checks, &config, None, |_| {}));
+    let two = pool(2).install(|| run_checks(&checks, &config, None, |_| {}));
+    let again = pool(2).install(|| run_checks(&checks, &config, None, |_| {}));
+    assert_eq!(one.to_markdown(), two.to_markdown());
+    assert_eq!(two.to_markdown(), again.to_markdown());
+    assert_eq!(one.to_json().unwrap(), two.to_json().unwrap());
+    let ids: Vec<_> = one.results.iter().map(|r| r.meta.id.clone()).collect();
+    let expected: Vec<_> = checks.iter().map(|c| c.meta.id.clone()).collect();
+    assert_eq!(ids, expected, "report keeps registry order");
+}
+
+#[test]
+fn result_does_not_depend_on_which_other_checks_run() {
+    let config = RunConfig {
+        seed: 11,
+        quick: true,
+    };
+    let all = run_checks(&registry(), &config, None, |_| {});
+    for id in ["thm-3.1-cpi-bound", "thm-3.2-cpi-step", "lemma-a.2-printed"] {
+        let alone = run_checks(&registry(), &config, Some(id), |_| {});
+        let in_all = all.results.iter().find(|r| r.meta.id == id).unwrap();
+        assert_eq!(&alone.results[0], in_all, "{id}");
+    }
+}
+
+#[test]
+fn different_seeds_draw_different_cases() {
+    let a = run_checks(
+        &registry(),
+        &RunConfig {
+            seed: 1,
+            quick: true,
+        },
+        Some("thm-3.1"),
+        |_| {},
+    );
+    let b = run_checks(
+        &registry(),
+        &RunConfig {
+            seed: 2,
+            quick: true,
+        },
+        Some("thm-3.1"),
+        |_| {},
+    );
+    assert_ne!(a.results[0].outcome, b.results[0].outcome);
+}
+
+#[test]
+fn every_check_meets_its_expected_outcome_quick_and_full() {
+    for config in [
+        RunConfig {
+            seed: 0,
+            quick: true,
+        },
+        RunConfig {
+            seed: 1,
+            quick: true,
+        },
+        RunConfig {
+            seed: 0,
+            quick: false,
+        },
+    ] {
+        let report = run_checks(&registry(), &config, None, |_| {});
+        let unexpected: Vec<_> = report
+            .unexpected()
+            .iter()
+            .map(|r| r.meta.id.clone())
+            .collect();
+        assert!(report.all_as_expected(), "{config:?}: {unexpected:?}");
+        assert!(report.results.len() >= 26);
+    }
+}
+
+#[test]
+fn markdown_and_json_carry_every_figure() {
+    let report = run_checks(
+        &registry(),
+        &RunConfig {
+            seed: 3,
+            quick: true,
+        },
+        None,
+        |_| {},
+    );
+    let md = report.to_markdown();
+    assert!(!md.contains("NaN"));
+    for r in &report.results {
+        assert!(md.contains(&format!("### `{}`", r.meta.id)));
+        assert!(md.contains(&r.meta.false_alarm_rate));
+        if let Outcome::Violated { counterexample, .. } = &r.outcome {
+            assert!(md.contains(counterexample.as_str()));
+        }
+    }
+    let back: sepg_verification::Report = serde_json::from_str(&report.to_json().unwrap()).unwrap();
+    assert_eq!(back.results.len(), report.results.len());
+    for (b, r) in back.results.iter().zip(&report.results) {
+        assert_eq!(
+            (&b.meta, &b.figures, b.as_expected),
+            (&r.meta, &r.figures, r.as_expected)
+        );
+    }
+}
+
+/// Runs one check with broken bound functions and returns its outcome label.
+fn run_broken(id: &str, bounds: BoundFns) -> (&'static str, bool) {
+    let check = registry().into_iter().find(|c| c.meta.id == id).unwrap();
+    assert_eq!(
+        check
+            .run(&RunConfig {
+                seed: 0,
+                quick: true
+            })
+            .outcome
+            .label(),
+        "holds"
+    );
+    let r = check.with_bounds(bounds).run(&RunConfig {
+        seed: 0,
+        quick: true,
+    });
+    (r.outcome.label(), r.as_expected)
+}
+
+#[test]
+fn a_deliberately_broken_bound_is_caught() {
+    let b = BoundFns {
+        psi: || 0.5 * sepg_bounds::constants::psi(),
+        ..BoundFns::default()
+    };
+    assert_eq!(
+        run_broken("lemma-a.1-second-derivative-bound", b),
+        ("violated", false)
+    );
+
+    let b = BoundFns {
+        cpi_bound: |alpha, adv, _eps, gamma| alpha * adv / (1.0 - gamma),
+        ..BoundFns::default()
+    };
+    assert_eq!(run_broken("thm-3.1-cpi-bound", b), ("violated", false));
+
+    let b = BoundFns {
+        trpo_penalty: |_eps, _gamma| 0.0,
+        ..BoundFns::default()
+    };
+    assert_eq!(run_broken("thm-3.16-trpo-bound", b), ("violated", false));
+
+    let b = BoundFns {
+        l1_squared_bound: |dw| 0.9 * dw * dw,
+        ..BoundFns::default()
+    };
+    assert_eq!(run_broken("lemma-a.3-l1-squared", b), ("violated", false));
+}
+
+#[test]
+fn broken_bound_shows_in_the_report() {
+    let checks: Vec<_> = registry()
+        .into_iter()
+        .map(|c| {
+            let b = BoundFns {
+                state_distribution_bound: |d_inf, gamma| 0.5 * gamma / (1.0 - gamma) * d_inf,
+                ..BoundFns::default()
+            };
+            c.with_bounds(b)
+        })
+        .collect();
+    let report = run_checks(
+        &checks,
+        &RunConfig {
+            seed: 0,
+            quick: true,
+        },
+        Some("thm-3.4"),
+        |_| {},
+    );
+    let ids: Vec<_> = report
+        .unexpected()
+        .iter()
+        .map(|r| r.meta.id.as_str())
+        .collect();
+    assert_eq!(ids, ["thm-3.4-state-distribution"]);
+    assert!(!report.all_as_expected());
+    assert!(report.to_markdown().contains("DIFFERS FROM EXPECTED"));
+}
+
+#[test]
+fn derive_seed_is_pinned() {
+    // Value-stability: changing the derivation would silently change every report.
+    assert_eq!(derive_seed(0, "thm-3.1-cpi-bound"), PINNED_0);
+    assert_eq!(derive_seed(42, "lemma-a.2-printed"), PINNED_42);
+}
+
+#[test]
+fn clopper_pearson_matches_the_mpmath_table() {
+    let table = include_str!("data/clopper_pearson.csv");
+    let mut rows = 0;
+    for line in table.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (k, n): (u64, u64) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+        let conf: f64 = f[2].parse().unwrap();
+        let (up, lo): (f64, f64) = (f[3].parse().unwrap(), f[4].parse().unwrap());
+        let u = clopper_pearson_upper(k, n, conf).unwrap();
+        let l = clopper_pearson_lower(k, n, conf).unwrap();
+        // statrs' continued fraction for I_x(a, b) is accurate to ~1e-13 relative; 1e-9 leaves
+        // room for large n (1e5 trials) where the Beta parameters are large.
+        assert!(
+            (u - up).abs() <= 1e-9 * up.abs() + 1e-300,
+            "upper {line}: {u}"
+        );
+        assert!(
+            (l - lo).abs() <= 1e-9 * lo.abs() + 1e-300,
+            "lower {line}: {l}"
+        );
+        rows += 1;
+    }
+    assert_eq!(rows, 64);
+}
+
+#[test]
+fn clopper_pearson_rejects_bad_input() {
+    assert_eq!(
+        clopper_pearson_upper(1, 0, 0.95),
+        Err(StatsError::Counts {
+            successes: 1,
+            trials: 0
+        })
+    );
+    assert!(clopper_pearson_upper(5, 4, 0.95).is_err());
+    assert_eq!(
+        clopper_pearson_lower(1, 2, 1.0),
+        Err(StatsError::Confidence(1.0))
+    );
+    assert!(clopper_pearson_lower(1, 2, f64::NAN).is_err());
+}
+
+/// Two states: in state 0 action 0 stays (reward x), action 1 moves to the absorbing state 1
+/// (reward y); state 1 pays z forever. Everything has a closed form.
+fn two_state(x: f64, y: f64, z: f64, gamma: f64) -> FiniteMdp {
+    FiniteMdp::new(
+        2,
+        2,
+        vec![1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0],
+        vec![x, y, z, z],
+        gamma,
+        vec![1.0, 0.0],
+    )
+    .unwrap()
+}
+
+#[test]
+fn finite_mdp_matches_closed_forms() {
+    let (x, y, z, gamma, alpha) = (-1.0, 1.0, 1.0, 0.9, 0.3);
+    let mdp = two_state(x, y, z, gamma);
+    let stay = TabularPolicy::new(2, 2, vec![1.0, 0.0, 1.0, 0.0]).unwrap();
+    let e = mdp.evaluate(&stay).unwrap();
+    assert!((e.j() - x / (1.0 - gamma)).abs() < 1e-12);
+    let advantage = y + gamma * z / (1.0 - gamma) - x / (1.0 - gamma);
+    assert!((e.advantage(0, 1) - advantage).abs() < 1e-12);
+    let greedy = e.greedy();
+    assert_eq!(greedy.prob(0, 1), 1.0);
+    assert!((e.policy_advantage(&greedy) - advantage).abs() < 1e-12);
+    // Mixture: leave with probability α; d(0) = (1−γ)/(1−γ(1−α)), ΔJ = αA/(1−γ(1−α)).
+    let mix = stay.mixture(&greedy, alpha).unwrap();
+    let em = mdp.evaluate(&mix).unwrap();
+    let d0 = (1.0 - gamma) / (1.0 - gamma * (1.0 - alpha));
+    assert!((em.state_distribution()[0] - d0).abs() < 1e-12);
+    assert!((em.state_distribution().iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    let gain = alpha * advantage / (1.0 - gamma * (1.0 - alpha));
+    assert!((em.j() - e.j() - gain).abs() < 1e-12);
+    assert!((stay.sup_l1_distance(&mix).unwrap() - 2.0 * alpha).abs() < 1e-15);
+    assert!((mdp.discounted_sum_along(&stay, &[1.0, 0.0]).unwrap() - 10.0).abs() < 1e-9);
+}
+
+#[test]
+fn thm_3_2_counterexample_in_closed_form() {
+    // The printed CPI step α* = (1−γ)𝔸/(4R) guarantees 𝔸²/(8R) only if α* ≤ (1−γ)/γ here.
+    let (gamma, r) = (0.9, 1.0);
+    let mdp = two_state(-r, r, r, gamma);
+    let stay = TabularPolicy::new(2, 2, vec![1.0, 0.0, 1.0, 0.0]).unwrap();
+    let e = mdp.evaluate(&stay).unwrap();
+    let greedy = e.greedy();
+    let adv = e.policy_advantage(&greedy);
+    assert!((adv - 2.0 * r / (1.0 - gamma)).abs() < 1e-12);
+    let alpha = (1.0 - gamma) * adv / (4.0 * r);
+    let gain = mdp
+        .evaluate(&stay.mixture(&greedy, alpha).unwrap())
+        .unwrap()
+        .j()
+        - e.j();
+    // 𝔸 = 20, α* = 1/2: ΔJ = α𝔸/(1 − γ(1 − α)) = 10/0.55 while 𝔸²/(8R) = 50.
+    assert!((gain - 10.0 / 0.55).abs() < 1e-9);
+    assert!(gain < adv * adv / (8.0 * r) - 30.0);
+}
+
+#[test]
+fn finite_mdp_rejects_bad_input() {
+    assert!(matches!(
+        FiniteMdp::new(1, 1, vec![1.0], vec![0.0], 1.0, vec![1.0]),
+        Err(MdpError::Discount(_))
+    ));
+    assert!(matches!(
+        FiniteMdp::new(1, 1, vec![0.5], vec![0.0], 0.5, vec![1.0]),
+        Err(MdpError::NotADistribution(_))
+    ));
+    assert!(matches!(
+        FiniteMdp::new(1, 1, vec![1.0], vec![f64::NAN], 0.5, vec![1.0]),
+        Err(MdpError::Reward {
+            state: 0,
+            action: 0
+        })
+    ));
+    assert!(matches!(
+        FiniteMdp::new(2, 1, vec![1.0], vec![0.0], 0.5, vec![1.0]),
+        Err(MdpError::Dimension(_))
+    ));
+    let mdp = FiniteMdp::new(1, 1, vec![1.0], vec![0.0], 0.5, vec![1.0]).unwrap();
+    assert!(matches!(
+        mdp.evaluate(&TabularPolicy::uniform(2, 1).unwrap()),
+        Err(MdpError::Mismatch { .. })
+    ));
+    assert!(
+        TabularPolicy::uniform(1, 1)
+            .unwrap()
+            .mixture(&TabularPolicy::uniform(1, 1).unwrap(), 1.5)
+            .is_err()
+    );
+}
