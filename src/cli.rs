@@ -58,6 +58,18 @@ enum Command {
     Bounds(commands::bounds::BoundsArgs),
     /// Check every statement of the thesis numerically and report the outcomes.
     Verify(commands::verify::VerifyArgs),
+    /// Exact J and gradients of an LQG preset (closed form, or dynamic programming if clipped).
+    Exact(commands::exact::ExactArgs),
+    /// A Mountain Car trajectory from a given state under given actions.
+    Replay(commands::replay::ReplayArgs),
+    /// Monte Carlo J, grad_v J and grad_w J with 95% confidence intervals.
+    Estimate(commands::estimate::EstimateArgs),
+    /// Run SEPG or a comparison algorithm into a run folder (log, summary, checkpoint).
+    Run(commands::run::RunArgs),
+    /// Run every (preset, variant, σ⁰, seed) of a sweep file in parallel, or one shard of it.
+    Sweep(commands::sweep::SweepArgs),
+    /// Combine the shard folders of one sweep into a single sweep folder.
+    Merge(commands::merge::MergeArgs),
 }
 
 /// Parses the command line, runs the command and maps failures to exit statuses.
@@ -90,6 +102,12 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Bounds(args) => commands::bounds::run(&args),
         Command::Verify(args) => commands::verify::run(&args),
+        Command::Exact(args) => commands::exact::run(&args),
+        Command::Replay(args) => commands::replay::run(&args),
+        Command::Estimate(args) => commands::estimate::run(&args),
+        Command::Run(args) => commands::run::run(&args),
+        Command::Sweep(args) => commands::sweep::run(&args),
+        Command::Merge(args) => commands::merge::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

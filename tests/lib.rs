@@ -1,4 +1,5 @@
 //! Integration tests of the `sepg` command-line interface, compiled into one binary.
 
 mod cli_bounds;
+mod cli_exact;
 mod common;

@@ -1,4 +1,12 @@
 //! One module per `sepg` subcommand.
 
 pub mod bounds;
+pub mod estimate;
+pub mod exact;
+pub mod merge;
+pub mod parse;
+pub mod replay;
+pub mod run;
+pub mod runfmt;
+pub mod sweep;
 pub mod verify;

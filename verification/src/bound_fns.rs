@@ -4,6 +4,10 @@
 //! All quantities use the thesis's conventions: unnormalised values J, V, Q, A and the
 //! normalised future-state distribution d (Definition 2.5).
 
+use sepg_bounds::BoundsError;
+use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::outcome::StepOutcome;
+
 /// Function pointers to every closed form checked by the harness; [`BoundFns::default`] holds
 /// the printed formulas.
 #[derive(Debug, Clone, Copy)]
@@ -30,10 +34,16 @@ pub struct BoundFns {
     pub psi: fn() -> f64,
     /// Lemma A.3's bound on ‖π_{w'} − π_w‖²: see [`l1_squared_bound`].
     pub l1_squared_bound: fn(f64) -> f64,
+    /// Theorem 4.2, eq. (4.8): lower bound of the greedy-coordinate v-update for a step α
+    /// (default `sepg_bounds::v_update::bound`).
+    pub v_update_bound: fn(&TaskConstants, f64, &[f64], f64) -> Result<f64, BoundsError>,
+    /// Theorem 4.2, eqs. (4.9)–(4.10): safe step sizes for a required improvement C
+    /// (default `sepg_bounds::v_update::safe_step`).
+    pub v_safe_step: fn(&TaskConstants, f64, &[f64], f64) -> Result<StepOutcome, BoundsError>,
 }
 
 impl Default for BoundFns {
-    /// The formulas as printed in the thesis (ψ from `sepg-bounds`).
+    /// The formulas as printed in the thesis (ψ and the Chapter 4 bounds from `sepg-bounds`).
     fn default() -> Self {
         Self {
             cpi_bound,
@@ -47,6 +57,8 @@ impl Default for BoundFns {
             trpo_penalty,
             psi: sepg_bounds::constants::psi,
             l1_squared_bound,
+            v_update_bound: sepg_bounds::v_update::bound,
+            v_safe_step: sepg_bounds::v_update::safe_step,
         }
     }
 }

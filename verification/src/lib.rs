@@ -20,6 +20,7 @@ pub mod bound_fns;
 mod check;
 mod checks;
 pub mod finite_mdp;
+mod lqg;
 mod report;
 mod search;
 pub mod stats;

@@ -7,6 +7,7 @@ use sepg_mdp::Batch;
 
 use crate::error::EstimatorError;
 use crate::estimate::Estimate;
+use crate::kernel::{HTerms, ScoreTerms, Sums};
 
 /// Which policy parameter a gradient is taken with respect to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -128,13 +129,13 @@ impl Target {
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct Estimator {
-    /// Baseline of the current row per (step, component).
-    row_base: Vec<f64>,
-    /// Running prefix sums (leave-one-out) or totals (plug-in) of the baseline terms
-    /// `(num, den)` per (step, component).
-    pre: Vec<f64>,
-    /// Suffix sums over rows of the baseline terms (leave-one-out fit).
-    suf: Vec<f64>,
+    /// Buffers of the baseline fit.
+    sums: Sums,
+    /// Per-trajectory returns (REINFORCE).
+    returns: Vec<f64>,
+    /// Products `u = G H F` and control variates `z` of `ĥ`, per (trajectory, step, pair).
+    h_u: Vec<f64>,
+    h_z: Vec<f64>,
     /// Scratch estimates and vectors of the composite estimators.
     pub(crate) tmp_g: Estimate,
     pub(crate) vec_a: Vec<f64>,
@@ -202,14 +203,6 @@ pub(crate) fn validate(batch: &Batch, min_n: usize) -> Result<(), EstimatorError
         return Err(EstimatorError::InvalidSigma { index, value });
     }
     Ok(())
-}
-
-/// Cumulative score of `param` for trajectory `i` at step `t`.
-fn score(batch: &Batch, param: Param, i: usize, t: usize) -> &[f64] {
-    match param {
-        Param::V => batch.score_v(i, t),
-        Param::W => batch.score_w(i, t),
-    }
 }
 
 fn dim_of(batch: &Batch, param: Param) -> usize {
@@ -406,11 +399,8 @@ impl Estimator {
         out.finish()
     }
 
-    /// Runs one estimator on the trajectories `rows`, writing `rows.len() × comps` samples.
-    ///
-    /// Two passes over the batch: the baseline sums (suffix sums over rows for the
-    /// leave-one-out fit, totals for the plug-in fit), then per row its baseline and samples
-    /// (and the running prefix sums). Terms are recomputed from the batch on the fly.
+    /// Runs one estimator on the trajectories `rows`, writing `rows.len() × comps` samples
+    /// (see [`crate::kernel`]; every baseline is fitted on `rows` only).
     pub(crate) fn kernel(
         &mut self,
         batch: &Batch,
@@ -420,221 +410,99 @@ impl Estimator {
         fit: BaselineFit,
         out: &mut [f64],
     ) {
-        let (steps, comps) = match target {
-            Target::Reinforce(p) => (1, dim_of(batch, p)),
-            Target::Gpomdp(p) | Target::Pgt(p) => (batch.horizon, dim_of(batch, p)),
-            Target::H => (batch.horizon, batch.dim_w * batch.dim_v),
-        };
-        let width = steps * comps;
+        let h = batch.horizon;
         let nr = rows.len();
-        let fit = match baseline {
-            Baseline::None => None,
-            Baseline::Mean | Baseline::Optimal => Some(fit),
+        let optimal = baseline == Baseline::Optimal;
+        let scores = |p: Param| match p {
+            Param::V => (&batch.cum_score_v[rows.start * h * batch.dim_v..], batch.dim_v),
+            Param::W => (&batch.cum_score_w[rows.start * h * batch.dim_w..], batch.dim_w),
         };
-        self.row_base.clear();
-        self.row_base.resize(width, 0.0);
-        self.pre.clear();
-        self.pre.resize(2 * width, 0.0);
-        match fit {
-            None => {}
-            Some(BaselineFit::PlugIn) => {
-                for i in rows.clone() {
-                    add_terms(batch, target, baseline, i, steps, comps, &mut self.pre);
-                }
-                for (b, nd) in self.row_base.iter_mut().zip(self.pre.chunks_exact(2)) {
-                    *b = ratio(nd[0], nd[1]);
-                }
+        let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
+        match target {
+            Target::Gpomdp(p) | Target::Pgt(p) => {
+                let (s, comps) = scores(p);
+                let terms = ScoreTerms {
+                    s,
+                    s_stride: h * comps,
+                    f: rewards,
+                    f_stride: h,
+                    steps: h,
+                    comps,
+                    optimal,
+                    pgt: matches!(target, Target::Pgt(_)),
+                };
+                self.sums.run(&terms, nr, baseline, fit, out);
             }
-            Some(BaselineFit::LeaveOneOut) => {
-                self.suf.clear();
-                self.suf.resize((nr + 1) * 2 * width, 0.0);
-                for (li, i) in rows.clone().enumerate().rev() {
-                    let (head, tail) = self.suf.split_at_mut((li + 1) * 2 * width);
-                    let row = &mut head[li * 2 * width..];
-                    row.copy_from_slice(&tail[..2 * width]);
-                    add_terms(batch, target, baseline, i, steps, comps, row);
-                }
+            Target::Reinforce(p) => {
+                let (s, comps) = scores(p);
+                self.returns.clear();
+                self.returns
+                    .extend(rows.clone().map(|i| batch.discounted_return(i)));
+                let terms = ScoreTerms {
+                    s: &s[(h - 1) * comps..],
+                    s_stride: h * comps,
+                    f: &self.returns,
+                    f_stride: 1,
+                    steps: 1,
+                    comps,
+                    optimal,
+                    pgt: false,
+                };
+                self.sums.run(&terms, nr, baseline, fit, out);
             }
-        }
-        for ((li, i), x) in rows.enumerate().zip(out.chunks_exact_mut(comps)) {
-            if fit == Some(BaselineFit::LeaveOneOut) {
-                let others = &self.suf[(li + 1) * 2 * width..(li + 2) * 2 * width];
-                for ((b, p), o) in self
-                    .row_base
-                    .iter_mut()
-                    .zip(self.pre.chunks_exact(2))
-                    .zip(others.chunks_exact(2))
-                {
-                    *b = ratio(p[0] + o[0], p[1] + o[1]);
-                }
-                add_terms(batch, target, baseline, i, steps, comps, &mut self.pre);
-            }
-            match target {
-                Target::Pgt(p) => pgt_row(batch, p, i, &self.row_base, x),
-                _ => {
-                    x.fill(0.0);
-                    match row_view(batch, target, i) {
-                        Row::Score { s, f } => score_samples(s, f, &self.row_base, x),
-                        Row::Reinforce { s, ret } => score_samples(s, &[ret], &self.row_base, x),
-                        Row::H => {
-                            for t in 0..steps {
-                                let b = &self.row_base[t * comps..(t + 1) * comps];
-                                h_terms(batch, baseline, i, t, |c, u, z, _, _| {
-                                    x[c] += u - b[c] * z;
-                                });
-                            }
-                        }
-                    }
-                }
+            Target::H => {
+                self.fill_h(batch, rows, baseline);
+                let terms = HTerms {
+                    u: &self.h_u,
+                    z: &self.h_z,
+                    f: rewards,
+                    steps: h,
+                    comps: batch.dim_w * batch.dim_v,
+                    optimal,
+                };
+                self.sums.run(&terms, nr, baseline, fit, out);
             }
         }
     }
-}
 
-/// Calls `f(c, u, z, num, den)` for every pair `c = j · dim_v + k` of `ĥ` at step `t` of
-/// trajectory `i`: the sample is `Σ_t (u − b z)` and the baseline `b = Σ num / Σ den`, with
-/// `u = G H F`; optimal (B.2): `z = G + H`, `(num, den) = (u z, z²)`; mean: `z = G H`,
-/// `(num, den) = (F, 1)`.
-#[inline(always)]
-fn h_terms(
-    batch: &Batch,
-    baseline: Baseline,
-    i: usize,
-    t: usize,
-    mut f: impl FnMut(usize, f64, f64, f64, f64),
-) {
-    let g = batch.score_v(i, t);
-    let w = batch.score_w(i, t);
-    let fr = batch.rewards(i)[t];
-    let m = batch.dim_v;
-    for (j, (wj, sj)) in w.iter().zip(&batch.sigma).enumerate() {
-        let hj = wj / sj;
-        for (k, gk) in g.iter().enumerate() {
-            let u = gk * hj * fr;
-            let (z, num, den) = match baseline {
-                Baseline::None => (0.0, 0.0, 0.0),
-                Baseline::Mean => (gk * hj, fr, 1.0),
-                Baseline::Optimal => {
-                    let z = gk + hj;
-                    (z, u * z, z * z)
-                }
-            };
-            f(j * m + k, u, z, num, den);
-        }
-    }
-}
-
-/// Adds the baseline terms `(num, den)` of trajectory `i` to `acc` (layout `[(t · comps + c) · 2]`).
-fn add_terms(
-    batch: &Batch,
-    target: Target,
-    baseline: Baseline,
-    i: usize,
-    steps: usize,
-    comps: usize,
-    acc: &mut [f64],
-) {
-    match row_view(batch, target, i) {
-        Row::Score { s, f } => return score_add_terms(s, f, baseline, acc),
-        Row::Reinforce { s, ret } => return score_add_terms(s, &[ret], baseline, acc),
-        Row::H => {}
-    }
-    for t in 0..steps {
-        let row = &mut acc[2 * t * comps..2 * (t + 1) * comps];
-        h_terms(batch, baseline, i, t, |c, _, _, num, den| {
-            row[2 * c] += num;
-            row[2 * c + 1] += den;
-        });
-    }
-}
-
-/// The data of one trajectory for a score target, as contiguous slices.
-enum Row<'a> {
-    /// G(PO)MDP, PGT: cumulative scores (`steps × comps`) and `F_t = γ^t r_t`.
-    Score { s: &'a [f64], f: &'a [f64] },
-    /// REINFORCE: the last cumulative score and the return.
-    Reinforce { s: &'a [f64], ret: f64 },
-    /// `ĥ`: computed term by term.
-    H,
-}
-
-fn row_view(batch: &Batch, target: Target, i: usize) -> Row<'_> {
-    let steps = batch.horizon;
-    let row = |p: Param| match p {
-        Param::V => &batch.cum_score_v[i * steps * batch.dim_v..(i + 1) * steps * batch.dim_v],
-        Param::W => &batch.cum_score_w[i * steps * batch.dim_w..(i + 1) * steps * batch.dim_w],
-    };
-    match target {
-        Target::Gpomdp(p) | Target::Pgt(p) => Row::Score {
-            s: row(p),
-            f: batch.rewards(i),
-        },
-        Target::Reinforce(p) => Row::Reinforce {
-            s: score(batch, p, i, steps - 1),
-            ret: batch.discounted_return(i),
-        },
-        Target::H => Row::H,
-    }
-}
-
-/// `x_c = Σ_t S_{t,c} (F_t − b_{t,c})` for one trajectory (`comps = x.len()`).
-fn score_samples(s: &[f64], f: &[f64], base: &[f64], x: &mut [f64]) {
-    let comps = x.len();
-    for ((st, bt), ft) in s.chunks_exact(comps).zip(base.chunks_exact(comps)).zip(f) {
-        for ((xc, sc), bc) in x.iter_mut().zip(st).zip(bt) {
-            *xc += sc * (ft - bc);
-        }
-    }
-}
-
-/// Adds the baseline terms of one trajectory: `(S² F, S²)` (optimal) or `(F, 1)` (mean).
-fn score_add_terms(s: &[f64], f: &[f64], baseline: Baseline, acc: &mut [f64]) {
-    let comps = s.len() / f.len();
-    for ((st, at), &ft) in s
-        .chunks_exact(comps)
-        .zip(acc.chunks_exact_mut(2 * comps))
-        .zip(f)
-    {
-        for (sc, a) in st.iter().zip(at.chunks_exact_mut(2)) {
-            match baseline {
-                Baseline::None => {}
-                Baseline::Mean => {
-                    a[0] += ft;
-                    a[1] += 1.0;
-                }
-                Baseline::Optimal => {
-                    let s2 = sc * sc;
-                    a[0] += s2 * ft;
-                    a[1] += s2;
+    /// Fills `h_u` with `u = G_k H_j F` and `h_z` with the control variate of `baseline`
+    /// (`G_k + H_j` optimal, `G_k H_j` mean, 0 without baseline) for the trajectories `rows`,
+    /// entry `(r · steps + t) · dim_w · dim_v + j · dim_v + k`, where `H_j` is the cumulative
+    /// w-score divided by `σ_j` (the σ-score).
+    fn fill_h(&mut self, batch: &Batch, rows: Range<usize>, baseline: Baseline) {
+        let (h, m, l) = (batch.horizon, batch.dim_v, batch.dim_w);
+        let width = l * m;
+        let len = rows.len() * h * width;
+        self.h_u.resize(len, 0.0);
+        self.h_z.resize(len, 0.0);
+        let g_all = &batch.cum_score_v[rows.start * h * m..rows.end * h * m];
+        let w_all = &batch.cum_score_w[rows.start * h * l..rows.end * h * l];
+        let f_all = &batch.disc_rewards[rows.start * h..rows.end * h];
+        for ((((g, w), fr), u), z) in g_all
+            .chunks_exact(m)
+            .zip(w_all.chunks_exact(l))
+            .zip(f_all)
+            .zip(self.h_u.chunks_exact_mut(width))
+            .zip(self.h_z.chunks_exact_mut(width))
+        {
+            for (((wj, sj), uj), zj) in w
+                .iter()
+                .zip(&batch.sigma)
+                .zip(u.chunks_exact_mut(m))
+                .zip(z.chunks_exact_mut(m))
+            {
+                let hj = wj / sj;
+                for ((gk, uk), zk) in g.iter().zip(uj).zip(zj) {
+                    *uk = gk * hj * fr;
+                    *zk = match baseline {
+                        Baseline::None => 0.0,
+                        Baseline::Mean => gk * hj,
+                        Baseline::Optimal => gk + hj,
+                    };
                 }
             }
         }
     }
-}
-
-/// PGT order for one trajectory: `x_c = Σ_k (S_k − S_{k−1})_c Σ_{l≥k} (F_l − b_{l,c})`.
-fn pgt_row(batch: &Batch, param: Param, i: usize, base: &[f64], x: &mut [f64]) {
-    let comps = x.len();
-    let rewards = batch.rewards(i);
-    for (c, xc) in x.iter_mut().enumerate() {
-        let mut acc = 0.0;
-        let mut to_go = 0.0;
-        for t in (0..batch.horizon).rev() {
-            to_go += rewards[t] - base[t * comps + c];
-            let prev = if t == 0 {
-                0.0
-            } else {
-                score(batch, param, i, t - 1)[c]
-            };
-            acc += (score(batch, param, i, t)[c] - prev) * to_go;
-        }
-        *xc = acc;
-    }
-}
-
-/// Baseline ratio with the explicit convention `0/0 = 0` (Sec 2.3.2, SPEC §3).
-fn ratio(num: f64, den: f64) -> f64 {
-    if den > 0.0 { num / den } else { 0.0 }
 }
 
 /// Turns `ĥ` samples into `∂_σ ∇_v J` samples: subtracts `(2/σ_j) g_k` where `v_k` belongs to

@@ -26,10 +26,13 @@
 //! product of two gradients and is cross-fitted on two halves of the batch, see
 //! [`Estimator::surrogate_gradient`].
 
+#![deny(missing_docs)]
+
 pub mod confidence;
 pub mod error;
 pub mod estimate;
 pub mod gradient;
+mod kernel;
 pub mod quantile;
 pub mod surrogate;
 

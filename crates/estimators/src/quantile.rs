@@ -281,7 +281,8 @@ fn newton_upper(q: f64, c: f64, nu: f64) -> f64 {
         };
         let step = (next - t).abs();
         t = next;
-        if step <= 2.0 * f64::EPSILON * t || hi - lo <= 2.0 * f64::EPSILON * hi {
+        if step <= 2.0 * f64::EPSILON * t || (hi.is_finite() && hi - lo <= 2.0 * f64::EPSILON * hi)
+        {
             break;
         }
     }

@@ -93,6 +93,26 @@ proptest! {
     }
 
     #[test]
+    fn pgt_equals_gpomdp(
+        n in 2usize..7, h in 1usize..6, p in 1usize..3,
+        values in prop::collection::vec(-10f64..10.0, 1..64),
+        baseline in prop_oneof![Just(Baseline::None), Just(Baseline::Mean), Just(Baseline::Optimal)],
+    ) {
+        // Summation theorem: Σ_t S_t (F_t − b_t) = Σ_k (S_k − S_{k−1}) Σ_{l≥k} (F_l − b_l).
+        let b = batch_from(n, h, p, 1, &values, 0.5);
+        let mut est = Estimator::new();
+        let (mut g, mut q) = (Estimate::new(), Estimate::new());
+        for fit in [BaselineFit::PlugIn, BaselineFit::LeaveOneOut] {
+            est.gradient(&b, Param::V, GradientSpec { kind: Kind::Gpomdp, baseline, fit }, &mut g).unwrap();
+            est.gradient(&b, Param::V, GradientSpec { kind: Kind::Pgt, baseline, fit }, &mut q).unwrap();
+            let scale = g.samples().iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            for (x, y) in g.samples().iter().zip(q.samples()) {
+                prop_assert!((x - y).abs() <= 1e-12 * scale * (h as f64), "{x} vs {y}");
+            }
+        }
+    }
+
+    #[test]
     fn extreme_batches_never_give_nan(
         n in 2usize..6, h in 1usize..4,
         values in prop::collection::vec(prop_oneof![

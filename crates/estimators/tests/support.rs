@@ -6,7 +6,7 @@ use sepg_estimators::normal_quantile;
 use sepg_mdp::Batch;
 use sepg_mdp::env::{Environment, LqgEnv};
 use sepg_mdp::lqg_model::LqgModel;
-use sepg_mdp::oracle::{ClosedFormOracle, ExactEval, ExactOracle, Exploration, Horizon};
+use sepg_mdp::oracle::{ClosedFormOracle, ExactEval, ExactOracle, Horizon};
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::rollout_into;
@@ -25,12 +25,12 @@ impl Setup {
     pub fn new(model: LqgModel, v: &[f64], sigma: &[f64], horizon: usize) -> Setup {
         let model = model.with_clipping(false);
         let w: Vec<f64> = sigma.iter().map(|s| s.ln()).collect();
-        let oracle = ClosedFormOracle::new(&model).expect("valid model");
-        let exact = oracle
-            .evaluate(v, Exploration::Stochastic(&w), Horizon::Finite(horizon))
-            .expect("oracle");
         let features = v.len() / w.len();
         let policy = GaussianPolicy::new(v.to_vec(), w, features).expect("policy");
+        let exact = ClosedFormOracle::new(&model)
+            .expect("valid model")
+            .evaluate_policy(&policy, Horizon::Finite(horizon))
+            .expect("oracle");
         let env = LqgEnv::new(model)
             .expect("env")
             .with_horizon(horizon)

@@ -1,8 +1,11 @@
 //! The registry of checks: every statement of the thesis covered so far, in a fixed order.
 
+mod algorithm;
 mod appendix_a;
 mod chapter3;
 mod chapter4;
+mod lqg_exact;
+pub(crate) mod sampled;
 
 use crate::check::Check;
 
@@ -21,5 +24,8 @@ pub fn registry() -> Vec<Check> {
     let mut checks = chapter3::checks();
     checks.extend(appendix_a::checks());
     checks.extend(chapter4::checks());
+    checks.extend(lqg_exact::checks());
+    checks.extend(sampled::checks());
+    checks.extend(algorithm::checks());
     checks
 }

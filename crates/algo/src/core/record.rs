@@ -62,6 +62,10 @@ pub struct Record {
     pub below_noise_w: bool,
     /// Trajectories used since the start of the run, this iteration included.
     pub trajectories: u64,
-    /// Environment steps used since the start of the run, this iteration included.
+    /// Environment steps used since the start of the run, this iteration included. Blocks
+    /// that estimate gradients count the true trajectory lengths; a returns-only evaluation
+    /// (the target block of LV, ZV and SIM-ν) counts `n · min(H, time limit)` because
+    /// `sepg_mdp::rollout::rollout_returns_into` does not report lengths, which over-counts
+    /// the trajectories that terminate early (Mountain Car).
     pub steps: u64,
 }

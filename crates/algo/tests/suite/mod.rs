@@ -1,6 +1,8 @@
 //! The test modules, grouped so that they compile into the single `lib` test binary.
 mod common;
+mod comparison;
 mod config;
 mod determinism;
 mod exact;
+mod mountain_car;
 mod sampled;

@@ -1,0 +1,84 @@
+//! `sepg run`: one run of SEPG or a comparison algorithm into a run folder (`config.toml`,
+//! `log.csv`, `summary.json`, `checkpoint.json`), resumable bit for bit with `--resume`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::cli::CliError;
+use crate::commands::runfmt::{self, RUN_FILES, RunOptions, RunSpec, Summary};
+
+/// Arguments of `sepg run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Read options from a TOML file (keys are the flag names); flags override it.
+    #[arg(long, value_name = "FILE.toml")]
+    config: Option<PathBuf>,
+    #[command(flatten)]
+    spec: RunSpec,
+    /// Output run folder (must be absent or empty unless --force).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Write into a non-empty folder, replacing the run files a previous run left there.
+    #[arg(long)]
+    force: bool,
+    /// No progress bar and no summary line.
+    #[arg(long)]
+    quiet: bool,
+    /// Continue the interrupted run in DIR from its checkpoint (no other options).
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
+    /// Iterations between checkpoints (rows are appended to the log at each checkpoint).
+    #[arg(long = "checkpoint-every", value_name = "K", default_value_t = 500)]
+    checkpoint_every: u64,
+}
+
+/// The one-line report of a finished run.
+pub fn summary_line(dir: &std::path::Path, s: &Summary) -> String {
+    let mut line = format!(
+        "{}: {} iterations in {:.2} s ({:.0} it/s, {:.3e} env steps/s)",
+        dir.display(),
+        s.iterations,
+        s.wall_time_s,
+        s.iterations_per_s,
+        s.env_steps_per_s
+    );
+    if let Some(e) = s.abs_v_error {
+        line.push_str(&format!(", |v - v*| = {e:.4}"));
+    }
+    line
+}
+
+/// Runs `sepg run`.
+///
+/// # Errors
+/// Usage error (exit 2) for bad options, files or folders; failure (exit 1) for I/O errors,
+/// a failing iteration or an interrupt.
+pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    if args.checkpoint_every == 0 {
+        return Err(CliError::usage("--checkpoint-every must be at least 1"));
+    }
+    let opts = RunOptions { checkpoint_every: args.checkpoint_every, progress: !args.quiet };
+    runfmt::install_interrupt_handler();
+    let (dir, summary) = if let Some(dir) = &args.resume {
+        if args.config.is_some() || args.out.is_some() || args.force || args.spec != RunSpec::default() {
+            return Err(CliError::usage("--resume takes no other options than --quiet and --checkpoint-every"));
+        }
+        (dir.clone(), runfmt::resume(dir, opts)?)
+    } else {
+        let file = match &args.config {
+            Some(path) => RunSpec::from_file(path)?,
+            None => RunSpec::default(),
+        };
+        // A configuration copied from an earlier run is re-resolved by this version.
+        let merged = RunSpec { sepg_version: None, ..file.overlay(&args.spec) };
+        let resolved = merged.resolve()?;
+        let dir = args.out.clone().ok_or_else(|| CliError::usage("--out DIR is required"))?;
+        runfmt::check_out_dir(&dir, args.force, &RUN_FILES)?;
+        (dir.clone(), runfmt::start(&dir, &resolved, opts)?)
+    };
+    if !args.quiet {
+        println!("{}", summary_line(&dir, &summary));
+    }
+    Ok(())
+}

@@ -1,0 +1,988 @@
+//! Statements about estimated gradients: unbiasedness of the estimators (REINFORCE, G(PO)MDP,
+//! PGT, ĥ of Theorem B.1 and its baseline B.2), the summation theorem, the coverage of the
+//! t-intervals (Assumption 4.6), Chebyshev batch sizes (Corollary 3.13) and the
+//! high-probability bounds (Theorems 3.12, 4.7–4.9), against exact oracle values.
+//!
+//! Probabilistic claims are tested by a one-sided exact binomial (Clopper–Pearson) test on the
+//! observed violation rate; unbiasedness by a z-test on the mean of many independent batches,
+//! with a Bonferroni correction across components.
+
+use std::fmt::Write as _;
+
+use proptest::prelude::*;
+use sepg_bounds::batch_size;
+use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::high_probability::{HighProbabilityBound, HpForm};
+use sepg_bounds::outcome::StepOutcome;
+use sepg_bounds::pirotta::{self, AdaptiveStep};
+use sepg_estimators::{
+    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Kind, Param, SurrogateEstimate,
+    Width, normal_quantile,
+};
+use sepg_mdp::Batch;
+use sepg_mdp::env::LqgEnv;
+use sepg_mdp::oracle::ExactEval;
+use sepg_mdp::policy::GaussianPolicy;
+use sepg_mdp::rng::SeedKey;
+use sepg_mdp::rollout::rollout;
+
+use crate::check::{
+    Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Outcome, Tolerance,
+    fmt_f64,
+};
+use crate::lqg::{HORIZON, Preset, Task};
+use crate::search::{Comparison, search};
+use crate::stats::{clopper_pearson_lower, clopper_pearson_upper};
+
+/// Family-wise false-alarm rate of every statistical check in this module.
+const FAMILY_ALPHA: f64 = 1e-3;
+
+/// A policy on a preset, with its exact values, rollouts and estimators.
+struct Setting {
+    task: Task,
+    env: LqgEnv,
+    policy: GaussianPolicy,
+    v: f64,
+    w: f64,
+    sigma: f64,
+    exact: ExactEval,
+}
+
+impl Setting {
+    fn new(preset: Preset, gamma: f64, sigma: f64, v: f64, clipped: bool) -> Option<Self> {
+        let task = if clipped {
+            Task::new(preset, gamma)?
+        } else {
+            Task::unclipped(preset, gamma)?
+        };
+        let env = task.env()?;
+        let w = sigma.ln();
+        let exact = task.eval(v, w)?;
+        Some(Self {
+            policy: GaussianPolicy::scalar(v, w).ok()?,
+            task,
+            env,
+            v,
+            w,
+            sigma,
+            exact,
+        })
+    }
+
+    fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
+        rollout(
+            &self.env,
+            &self.policy,
+            n,
+            HORIZON,
+            SeedKey::new(seed, index, 0),
+        )
+        .ok()
+    }
+
+    fn k(&self) -> &TaskConstants {
+        &self.task.k
+    }
+}
+
+/// One binomial test: `violations` out of `trials`, claimed rate at most `allowed`.
+pub(crate) struct Freq {
+    pub(crate) name: String,
+    pub(crate) violations: u64,
+    pub(crate) trials: u64,
+    pub(crate) allowed: f64,
+}
+
+/// Clopper–Pearson test of every [`Freq`] at family-wise level [`FAMILY_ALPHA`] (Bonferroni):
+/// a claim is rejected when the one-sided lower confidence bound on its violation rate exceeds
+/// the allowed rate.
+pub(crate) fn frequency_outcome(tests: &[Freq]) -> Evaluation {
+    let confidence = 1.0 - FAMILY_ALPHA / tests.len().max(1) as f64;
+    let mut figures = Vec::new();
+    let mut worst: Option<(f64, String)> = None;
+    let (mut margin, mut relative) = (f64::INFINITY, f64::INFINITY);
+    let mut trials = 0;
+    for t in tests.iter().filter(|t| t.trials > 0) {
+        trials += t.trials;
+        let rate = t.violations as f64 / t.trials as f64;
+        let (Ok(lo), Ok(hi)) = (
+            clopper_pearson_lower(t.violations, t.trials, confidence),
+            clopper_pearson_upper(t.violations, t.trials, 0.95),
+        ) else {
+            continue;
+        };
+        figures.push(Figure {
+            name: t.name.clone(),
+            value: format!(
+                "{}/{} violations, rate {}, 95% upper bound {}, allowed {}",
+                t.violations,
+                t.trials,
+                fmt_f64(rate),
+                fmt_f64(hi),
+                fmt_f64(t.allowed)
+            ),
+        });
+        if lo > t.allowed {
+            let amount = rate - t.allowed;
+            if worst.as_ref().is_none_or(|(a, _)| amount > *a) {
+                worst = Some((
+                    amount,
+                    format!(
+                        "{}: {}/{} violations (rate {}, one-sided {} lower bound {}) > allowed {}",
+                        t.name,
+                        t.violations,
+                        t.trials,
+                        fmt_f64(rate),
+                        fmt_f64(confidence),
+                        fmt_f64(lo),
+                        fmt_f64(t.allowed)
+                    ),
+                ));
+            }
+        }
+        margin = margin.min(t.allowed - rate);
+        relative = relative.min((t.allowed - rate) / t.allowed);
+    }
+    let outcome = match worst {
+        Some((amount, counterexample)) => Outcome::Violated {
+            counterexample,
+            amount,
+        },
+        None if trials == 0 => Outcome::Inconclusive {
+            reason: "no informative trial".into(),
+        },
+        None => Outcome::HoldsWithMargin {
+            margin,
+            relative_margin: relative,
+        },
+    };
+    Evaluation {
+        outcome,
+        cases: trials,
+        figures,
+    }
+}
+
+/// One z-test of an unbiasedness claim: the mean of `samples` (independent batch estimates)
+/// against the exact value.
+struct ZTest {
+    name: String,
+    samples: Vec<f64>,
+    truth: f64,
+}
+
+fn z_outcome(tests: &[ZTest]) -> Evaluation {
+    let m = tests.len().max(1) as f64;
+    let z_crit = normal_quantile(1.0 - FAMILY_ALPHA / (2.0 * m)).unwrap_or(f64::INFINITY);
+    let mut figures = vec![Figure {
+        name: "critical |z| (two-sided, Bonferroni)".into(),
+        value: fmt_f64(z_crit),
+    }];
+    let mut max_error = 0.0f64;
+    let mut worst: Option<(f64, String)> = None;
+    let mut cases = 0;
+    for t in tests {
+        let n = t.samples.len() as f64;
+        cases += t.samples.len() as u64;
+        let mean = t.samples.iter().sum::<f64>() / n;
+        let var = t.samples.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let se = (var / n).sqrt();
+        let z = (mean - t.truth) / se;
+        max_error = max_error.max((mean - t.truth).abs());
+        figures.push(Figure {
+            name: t.name.clone(),
+            value: format!(
+                "mean {} ± {} (s.e.), exact {}, z = {}",
+                fmt_f64(mean),
+                fmt_f64(se),
+                fmt_f64(t.truth),
+                fmt_f64(z)
+            ),
+        });
+        if !(z.abs() <= z_crit) && worst.as_ref().is_none_or(|(a, _)| z.abs() > *a) {
+            worst = Some((
+                z.abs(),
+                format!(
+                    "{}: mean {} vs exact {} (z = {})",
+                    t.name,
+                    fmt_f64(mean),
+                    fmt_f64(t.truth),
+                    fmt_f64(z)
+                ),
+            ));
+        }
+    }
+    let outcome = match worst {
+        Some((z, counterexample)) => Outcome::Violated {
+            counterexample,
+            amount: z - z_crit,
+        },
+        None => Outcome::Holds { max_error },
+    };
+    Evaluation {
+        outcome,
+        cases,
+        figures,
+    }
+}
+
+/// Trajectories per batch of the sampled checks (the experiments' N).
+const N: usize = 100;
+
+fn estimate(
+    est: &mut Estimator,
+    batch: &Batch,
+    param: Param,
+    spec: GradientSpec,
+) -> Option<Estimate> {
+    let mut out = Estimate::new();
+    est.gradient(batch, param, spec, &mut out).ok()?;
+    Some(out)
+}
+
+const NO_BASELINE: GradientSpec = GradientSpec {
+    kind: Kind::Gpomdp,
+    baseline: Baseline::None,
+    fit: BaselineFit::PlugIn,
+};
+
+fn assumption_4_6(ctx: &CheckContext<'_>) -> Evaluation {
+    let settings = [
+        (Preset::Lqg, 1.0, -0.1),
+        (Preset::Lqg, 0.2, -0.6),
+        (Preset::Lqg1d, 0.5, -0.3),
+    ];
+    let mut tests = Vec::new();
+    for (si, &(preset, sigma, v)) in settings.iter().enumerate() {
+        let Some(s) = Setting::new(preset, 0.99, sigma, v, true) else {
+            continue;
+        };
+        let deltas = [0.2, 0.05];
+        // counts[delta][param] = (violations, trials)
+        let mut counts = [[(0u64, 0u64); 2]; 2];
+        let mut est = Estimator::new();
+        for b in 0..u64::from(ctx.cases) {
+            let Some(batch) = s.batch(N, ctx.seed ^ si as u64, b) else {
+                continue;
+            };
+            for (p, (param, truth)) in [
+                (Param::V, s.exact.grad_v[0]),
+                (Param::W, s.exact.grad_w[0]),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let Some(e) = estimate(&mut est, &batch, param, GradientSpec::default()) else {
+                    continue;
+                };
+                for (di, &delta) in deltas.iter().enumerate() {
+                    let Ok(conf) = e.confidence(Width::StudentT, delta) else {
+                        continue;
+                    };
+                    counts[di][p].1 += 1;
+                    if (e.mean()[0] - truth).abs() > conf.eps {
+                        counts[di][p].0 += 1;
+                    }
+                }
+            }
+        }
+        for (di, &delta) in deltas.iter().enumerate() {
+            for (p, name) in ["∇_v J", "∇_w J"].iter().enumerate() {
+                tests.push(Freq {
+                    name: format!("{preset:?} σ = {sigma}, v = {v}, δ = {delta}, {name}"),
+                    violations: counts[di][p].0,
+                    trials: counts[di][p].1,
+                    allowed: delta,
+                });
+            }
+        }
+    }
+    frequency_outcome(&tests)
+}
+
+/// Which high-probability theorem.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hp {
+    /// Theorem 4.7: v-update along ∇̂_v J.
+    V,
+    /// Theorem 4.8: w-update along ∇̂_w J.
+    WJ,
+    /// Theorem 4.9: w-update along ∇̂_w L.
+    WL,
+}
+
+/// Which requirement and which end of the safe interval.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Requirement {
+    /// C = 0 at the largest step (hi) and C = C_max at the vertex.
+    NonNegative,
+    /// C = −C_max/10 at the end of the interval opposite to the favoured direction.
+    Negative,
+}
+
+/// Runs `batches` batches of one high-probability theorem and counts realised violations.
+fn hp_counts(
+    s: &Setting,
+    which: Hp,
+    form: HpForm,
+    req: Requirement,
+    delta: f64,
+    seed: u64,
+    batches: u32,
+) -> Vec<(u64, u64, &'static str)> {
+    let mut counts = match req {
+        Requirement::NonNegative => vec![(0, 0, "C = 0, largest step"), (0, 0, "C = C_max, vertex")],
+        Requirement::Negative => vec![(0, 0, "C = −C_max/10, step opposite to the estimate")],
+    };
+    let mut est = Estimator::new();
+    let tol = 1e-9 * s.exact.j.abs().max(1.0);
+    for b in 0..u64::from(batches) {
+        let Some(batch) = s.batch(N, seed, b) else {
+            continue;
+        };
+        let (Some(gv), Some(gw)) = (
+            estimate(&mut est, &batch, Param::V, GradientSpec::default()),
+            estimate(&mut est, &batch, Param::W, GradientSpec::default()),
+        ) else {
+            continue;
+        };
+        let (Ok(cv), Ok(cw)) = (
+            gv.confidence(Width::StudentT, delta),
+            gw.confidence(Width::StudentT, delta),
+        ) else {
+            continue;
+        };
+        let (bound, direction) = match which {
+            Hp::V => (
+                HighProbabilityBound::v_update(s.k(), s.sigma, gv.mean(), cv.eps),
+                gv.mean()[0],
+            ),
+            Hp::WJ => (
+                HighProbabilityBound::w_along_j(s.k(), s.sigma, gw.mean()[0], cw.eps),
+                gw.mean()[0],
+            ),
+            Hp::WL => {
+                let mut sur = SurrogateEstimate::new();
+                if est
+                    .surrogate_gradient_for_task(&batch, GradientSpec::default(), s.k(), &mut sur)
+                    .is_err()
+                {
+                    continue;
+                }
+                let Ok(cl) = sur.grad_w_l().confidence(Width::StudentT, delta) else {
+                    continue;
+                };
+                let gl = sur.grad_w_l().mean()[0];
+                (
+                    HighProbabilityBound::w_along_l(s.k(), s.sigma, gw.mean()[0], cw.eps, gl, cl.eps),
+                    gl,
+                )
+            }
+        };
+        let Ok(Some(bound)) = bound else {
+            continue;
+        };
+        let c_max = bound.c_max();
+        let plan: Vec<(f64, bool)> = match req {
+            Requirement::NonNegative => vec![(0.0, true), (c_max, false)],
+            Requirement::Negative => vec![(-0.1 * c_max, true)],
+        };
+        for (i, (required, far)) in plan.into_iter().enumerate() {
+            let Ok(StepOutcome::Feasible(interval)) = bound.safe_step(required, form) else {
+                continue;
+            };
+            let x = match req {
+                Requirement::NonNegative if far => interval.hi,
+                Requirement::NonNegative => interval.vertex,
+                Requirement::Negative => {
+                    if bound.direction > 0.0 {
+                        interval.lo
+                    } else {
+                        interval.hi
+                    }
+                }
+            };
+            let step = x * direction;
+            let j1 = match which {
+                Hp::V => s.task.j(s.v + step, s.w),
+                Hp::WJ | Hp::WL => s.task.j(s.v, s.w + step),
+            };
+            let Some(j1) = j1 else { continue };
+            counts[i].1 += 1;
+            if j1 - s.exact.j < required - tol {
+                counts[i].0 += 1;
+            }
+        }
+    }
+    counts
+}
+
+fn hp_settings() -> [(Preset, f64, f64); 2] {
+    [(Preset::Lqg, 1.0, -0.1), (Preset::Lqg1d, 0.5, -0.3)]
+}
+
+/// Allowed violation rate: (1 − δ)^m guarantee with m estimated gradients.
+fn allowed(which: Hp, delta: f64) -> f64 {
+    match which {
+        Hp::V | Hp::WJ => delta,
+        Hp::WL => 1.0 - (1.0 - delta) * (1.0 - delta),
+    }
+}
+
+fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirement) -> Evaluation {
+    let delta = 0.2;
+    let mut tests = Vec::new();
+    for (si, &(preset, sigma, v)) in hp_settings().iter().enumerate() {
+        let Some(s) = Setting::new(preset, 0.9, sigma, v, true) else {
+            continue;
+        };
+        for &which in theorems {
+            let counts = hp_counts(&s, which, form, req, delta, ctx.seed ^ si as u64, ctx.cases);
+            for (violations, trials, label) in counts {
+                tests.push(Freq {
+                    name: format!("{which:?} on {preset:?} σ = {sigma}, v = {v}, δ = {delta}, {label}"),
+                    violations,
+                    trials,
+                    allowed: allowed(which, delta),
+                });
+            }
+        }
+    }
+    frequency_outcome(&tests)
+}
+
+fn thm_4_7(ctx: &CheckContext<'_>) -> Evaluation {
+    hp_check(ctx, &[Hp::V], HpForm::SignAware, Requirement::NonNegative)
+}
+
+fn thm_4_8(ctx: &CheckContext<'_>) -> Evaluation {
+    hp_check(ctx, &[Hp::WJ], HpForm::SignAware, Requirement::NonNegative)
+}
+
+fn thm_4_9(ctx: &CheckContext<'_>) -> Evaluation {
+    hp_check(ctx, &[Hp::WL], HpForm::SignAware, Requirement::NonNegative)
+}
+
+fn negative_c_printed(ctx: &CheckContext<'_>) -> Evaluation {
+    hp_check(ctx, &[Hp::V, Hp::WJ, Hp::WL], HpForm::Thesis, Requirement::Negative)
+}
+
+fn negative_c_sign_aware(ctx: &CheckContext<'_>) -> Evaluation {
+    hp_check(ctx, &[Hp::V, Hp::WJ, Hp::WL], HpForm::SignAware, Requirement::Negative)
+}
+
+fn thm_3_12(ctx: &CheckContext<'_>) -> Evaluation {
+    let delta = 0.2;
+    let mut tests = Vec::new();
+    for (si, &(preset, sigma, v)) in hp_settings().iter().enumerate() {
+        let Some(s) = Setting::new(preset, 0.9, sigma, v, true) else {
+            continue;
+        };
+        let (mut violations, mut trials) = (0, 0);
+        let mut est = Estimator::new();
+        let tol = 1e-9 * s.exact.j.abs().max(1.0);
+        for b in 0..u64::from(ctx.cases) {
+            let Some(batch) = s.batch(N, ctx.seed ^ si as u64, b) else {
+                continue;
+            };
+            let Some(g) = estimate(&mut est, &batch, Param::V, GradientSpec::default()) else {
+                continue;
+            };
+            let Ok(conf) = g.confidence(Width::StudentT, delta) else {
+                continue;
+            };
+            let Ok(AdaptiveStep::Step { alpha, guarantee }) =
+                pirotta::hp_optimal_step(s.k(), sigma, g.mean(), &[conf.eps])
+            else {
+                continue;
+            };
+            let Some(j1) = s.task.j(v + alpha * g.mean()[0], s.w) else {
+                continue;
+            };
+            trials += 1;
+            if j1 - s.exact.j < guarantee - tol {
+                violations += 1;
+            }
+        }
+        tests.push(Freq {
+            name: format!("{preset:?} σ = {sigma}, v = {v}, δ = {delta}, α* = vertex"),
+            violations,
+            trials,
+            allowed: delta,
+        });
+    }
+    frequency_outcome(&tests)
+}
+
+/// Chebyshev batch sizes (Corollary 3.13): the batch size for ε, δ and the violation count of
+/// |∇̂ − ∇| > ε over independent batches of that size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Chebyshev {
+    Gpomdp,
+    ReinforceCorrected,
+    ReinforcePrinted,
+}
+
+fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
+    let (gamma, sigma, v, delta) = (0.5, 1.0, -0.3, 0.2);
+    let Some(s) = Setting::new(Preset::Lqg, gamma, sigma, v, true) else {
+        return frequency_outcome(&[]);
+    };
+    let k = *s.k();
+    let (eps, kind) = match which {
+        Chebyshev::Gpomdp => (1.5, Kind::Gpomdp),
+        Chebyshev::ReinforceCorrected | Chebyshev::ReinforcePrinted => (4.0, Kind::Reinforce),
+    };
+    let n = match which {
+        Chebyshev::Gpomdp => batch_size::gpomdp(&k, sigma, delta, eps, HORIZON as u32),
+        Chebyshev::ReinforceCorrected => {
+            batch_size::reinforce(&k, sigma, delta, eps, HORIZON as u32)
+        }
+        Chebyshev::ReinforcePrinted => {
+            let (r, m) = (k.r_max(), k.m_phi());
+            let h = HORIZON as f64;
+            let printed = r * r * m * m * h * gamma.powi(2 * HORIZON as i32)
+                / (delta * eps * eps * sigma * sigma * (1.0 - delta).powi(2));
+            Ok(printed.ceil().max(1.0) as u64)
+        }
+    };
+    let Ok(n) = n else {
+        return frequency_outcome(&[]);
+    };
+    let spec = GradientSpec {
+        kind,
+        ..NO_BASELINE
+    };
+    let batch_n = usize::try_from(n).unwrap_or(usize::MAX).max(2);
+    let (mut violations, mut trials) = (0, 0);
+    let mut est = Estimator::new();
+    let batches = ctx.cases;
+    for b in 0..u64::from(batches) {
+        let Some(batch) = s.batch(batch_n, ctx.seed, b) else {
+            continue;
+        };
+        let Some(g) = estimate(&mut est, &batch, Param::V, spec) else {
+            continue;
+        };
+        trials += 1;
+        if (g.mean()[0] - s.exact.grad_v[0]).abs() > eps {
+            violations += 1;
+        }
+    }
+    let mut eval = frequency_outcome(&[Freq {
+        name: format!("{which:?}: N = {n} (batches of max(N, 2)), ε = {eps}, δ = {delta}"),
+        violations,
+        trials,
+        allowed: delta,
+    }]);
+    eval.figures.push(Figure {
+        name: "batch size N from the formula".into(),
+        value: n.to_string(),
+    });
+    eval
+}
+
+fn cor_3_13_gpomdp(ctx: &CheckContext<'_>) -> Evaluation {
+    cor_3_13(ctx, Chebyshev::Gpomdp)
+}
+
+fn cor_3_13_reinforce(ctx: &CheckContext<'_>) -> Evaluation {
+    cor_3_13(ctx, Chebyshev::ReinforceCorrected)
+}
+
+fn cor_3_13_reinforce_printed(ctx: &CheckContext<'_>) -> Evaluation {
+    cor_3_13(ctx, Chebyshev::ReinforcePrinted)
+}
+
+/// PGT and G(PO)MDP samples are equal trajectory by trajectory (summation theorem).
+fn summation(ctx: &CheckContext<'_>) -> Evaluation {
+    let strategy = (
+        prop_oneof![Just(Preset::Lqg), Just(Preset::Lqg1d)],
+        prop_oneof![Just(0.99), 0.0..0.999f64],
+        prop_oneof![Just(0.1), 0.05..2.0f64],
+        -1.8..0.2f64,
+        any::<u64>(),
+        prop_oneof![Just(Baseline::None), Just(Baseline::Mean), Just(Baseline::Optimal)],
+    );
+    search(ctx, strategy, |&(preset, gamma, sigma, v, seed, baseline)| {
+        let Some(task) = Task::new(preset, gamma) else {
+            return vec![];
+        };
+        let (Some(env), Ok(policy)) = (task.env(), GaussianPolicy::scalar(v, sigma.ln())) else {
+            return vec![];
+        };
+        let Ok(batch) = rollout(&env, &policy, 20, HORIZON, SeedKey::new(seed, 0, 0)) else {
+            return vec![];
+        };
+        let mut est = Estimator::new();
+        let mut out = Vec::new();
+        for param in [Param::V, Param::W] {
+            let spec = |kind| GradientSpec {
+                kind,
+                baseline,
+                fit: BaselineFit::LeaveOneOut,
+            };
+            let (Some(p), Some(g)) = (
+                estimate(&mut est, &batch, param, spec(Kind::Pgt)),
+                estimate(&mut est, &batch, param, spec(Kind::Gpomdp)),
+            ) else {
+                return vec![];
+            };
+            let scale = g.samples().iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+            out.extend(
+                p.samples()
+                    .iter()
+                    .zip(g.samples())
+                    .map(|(a, b)| Comparison::new(a / scale, b / scale)),
+            );
+        }
+        out
+    })
+}
+
+/// Batch means of one estimator over `batches` independent batches.
+fn batch_means(
+    s: &Setting,
+    seed: u64,
+    batches: u32,
+    mut f: impl FnMut(&mut Estimator, &Batch) -> Option<f64>,
+) -> Vec<f64> {
+    let mut est = Estimator::new();
+    (0..u64::from(batches))
+        .filter_map(|b| {
+            let batch = s.batch(N, seed, b)?;
+            f(&mut est, &batch)
+        })
+        .collect()
+}
+
+fn unbiased(ctx: &CheckContext<'_>) -> Evaluation {
+    let mut tests = Vec::new();
+    for (preset, sigma, v) in [(Preset::Lqg, 0.5, -0.3), (Preset::Lqg1d, 1.0, -0.6)] {
+        let Some(s) = Setting::new(preset, 0.9, sigma, v, false) else {
+            continue;
+        };
+        for kind in [Kind::Reinforce, Kind::Gpomdp, Kind::Pgt] {
+            for baseline in [Baseline::None, Baseline::Mean, Baseline::Optimal] {
+                for (param, truth) in [
+                    (Param::V, s.exact.grad_v[0]),
+                    (Param::W, s.exact.grad_w[0]),
+                ] {
+                    let spec = GradientSpec {
+                        kind,
+                        baseline,
+                        fit: BaselineFit::LeaveOneOut,
+                    };
+                    tests.push(ZTest {
+                        name: format!("{preset:?} (unclipped) {kind:?} {baseline:?} {param:?}"),
+                        samples: batch_means(&s, ctx.seed, ctx.cases, |est, batch| {
+                            estimate(est, batch, param, spec).map(|e| e.mean()[0])
+                        }),
+                        truth,
+                    });
+                }
+            }
+        }
+    }
+    z_outcome(&tests)
+}
+
+/// h(θ) = ∂_σ∇_vJ + (2/σ)∇_vJ from the oracle (Appendix B).
+fn exact_h(s: &Setting) -> f64 {
+    s.exact.mixed_sigma_v()[0] + 2.0 * s.exact.grad_v[0] / s.sigma
+}
+
+fn h_settings() -> [(Preset, f64, f64, bool); 3] {
+    [
+        (Preset::Lqg, 0.5, -0.3, true),
+        (Preset::Lqg1d, 1.0, -0.6, true),
+        (Preset::Lqg, 0.5, -0.3, false),
+    ]
+}
+
+fn h_mean(est: &mut Estimator, batch: &Batch, baseline: Baseline) -> Option<Estimate> {
+    let mut out = Estimate::new();
+    est.h(batch, baseline, BaselineFit::LeaveOneOut, &mut out)
+        .ok()?;
+    Some(out)
+}
+
+fn thm_b_1(ctx: &CheckContext<'_>) -> Evaluation {
+    let mut tests = Vec::new();
+    for (preset, sigma, v, clipped) in h_settings() {
+        let Some(s) = Setting::new(preset, 0.9, sigma, v, clipped) else {
+            continue;
+        };
+        tests.push(ZTest {
+            name: format!("{preset:?} clipped = {clipped}, σ = {sigma}, v = {v}: ĥ (B.3)"),
+            samples: batch_means(&s, ctx.seed, ctx.cases, |est, batch| {
+                h_mean(est, batch, Baseline::None).map(|e| e.mean()[0])
+            }),
+            truth: exact_h(&s),
+        });
+    }
+    z_outcome(&tests)
+}
+
+fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
+    let mut tests = Vec::new();
+    let mut ratios = String::new();
+    let mut worst_ratio = 0.0f64;
+    for (preset, sigma, v, clipped) in h_settings() {
+        let Some(s) = Setting::new(preset, 0.9, sigma, v, clipped) else {
+            continue;
+        };
+        let (mut var_none, mut var_opt) = (0.0, 0.0);
+        let samples = batch_means(&s, ctx.seed, ctx.cases, |est, batch| {
+            let none = h_mean(est, batch, Baseline::None)?;
+            let opt = h_mean(est, batch, Baseline::Optimal)?;
+            var_none += none.variance()[0];
+            var_opt += opt.variance()[0];
+            Some(opt.mean()[0])
+        });
+        let ratio = var_opt / var_none;
+        worst_ratio = worst_ratio.max(ratio);
+        let _ = write!(ratios, "{preset:?} clipped = {clipped}: {}; ", fmt_f64(ratio));
+        tests.push(ZTest {
+            name: format!("{preset:?} clipped = {clipped}, σ = {sigma}, v = {v}: ĥ with baseline B.2"),
+            samples,
+            truth: exact_h(&s),
+        });
+    }
+    let mut eval = z_outcome(&tests);
+    eval.figures.push(Figure {
+        name: "per-trajectory variance with the B.2 baseline / without".into(),
+        value: ratios,
+    });
+    if !matches!(eval.outcome, Outcome::Violated { .. }) && !(worst_ratio < 1.0) {
+        eval.outcome = Outcome::Violated {
+            counterexample: format!("variance ratio {} ≥ 1", fmt_f64(worst_ratio)),
+            amount: worst_ratio - 1.0,
+        };
+    }
+    eval
+}
+
+fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &str) -> CheckMeta {
+    CheckMeta {
+        id: id.into(),
+        statement: statement.into(),
+        location: location.into(),
+        claim: claim.into(),
+        ground_truth: ground_truth.into(),
+        sampling: String::new(),
+        kind: ClaimKind::UpperBound,
+        cases_full: 2000,
+        cases_quick: 300,
+        tolerance: Tolerance { abs: 0.0, rel: 0.0 },
+        false_alarm_rate: format!(
+            "{FAMILY_ALPHA} family-wise: one-sided Clopper–Pearson test of each claimed rate, \
+             Bonferroni across the tests of the check"
+        ),
+        expected: Expected::Holds,
+        notes: String::new(),
+    }
+}
+
+const DP_TRUTH: &str = "exact J_H and gradients of the clipped preset (DP oracle), \
+realised improvement J(θ′) − J(θ) evaluated exactly for the step computed from each batch";
+
+const Z_FAR: &str = "1e-3 family-wise: two-sided z-test of the mean of independent batch \
+estimates (N = 100 each), Bonferroni across components";
+
+/// The checks of this module, in registry order.
+pub(crate) fn checks() -> Vec<Check> {
+    let hp_sampling = "fixed settings lqg (σ = 1, v = −0.1) and lqg1d (σ = 0.5, v = −0.3), \
+        γ = 0.9, N = 100 trajectories per batch, G(PO)MDP with the leave-one-out optimal \
+        baseline, t-widths at δ = 0.2; independent batches (one per case)";
+    let mut a46 = meta(
+        "assumption-4.6-t-coverage",
+        "Assumption 4.6 with the t-based widths of Section 4.5",
+        "Section 4.5, eq. (4.22) and the t-interval, thesis lines 1276–1292",
+        "P(|∇̂_i − ∇_i| > ε_i) ≤ δ with ε_i = t(1−δ/2, N−1)·√(Var̂/N), for ∇_v J and ∇_w J.",
+        "exact gradients of the clipped presets (DP oracle)",
+    );
+    a46.sampling = "lqg (σ = 1, v = −0.1), lqg (σ = 0.2, v = −0.6), lqg1d (σ = 0.5, v = −0.3), \
+        γ = 0.99, N = 100, G(PO)MDP with the leave-one-out optimal baseline, δ ∈ {0.2, 0.05}; \
+        independent batches (one per case)"
+        .into();
+    a46.cases_quick = 2000;
+    a46.notes = "Measured; the t-interval relies on the central limit theorem (the thesis says so).".into();
+    let mut t47 = meta(
+        "thm-4.7-hp-v-update",
+        "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, SPEC §4 vertex)",
+        "Section 4.5, thesis lines 1300–1314",
+        "With the estimated gradient and ε, the v-step at the vertex (C = C_max) and the largest \
+         step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)^m (m = 1).",
+        DP_TRUTH,
+    );
+    t47.sampling = hp_sampling.into();
+    t47.notes = "Holds.".into();
+    let mut t48 = meta(
+        "thm-4.8-hp-w-update",
+        "Theorem 4.8, eqs. (4.27)–(4.29)",
+        "Section 4.5, thesis lines 1316–1328",
+        "The w-step along ∇̂_wJ at the vertex (C = C_max) and the largest step for C = 0 realise \
+         J(θ′) − J(θ) ≥ C except with probability ≤ δ.",
+        DP_TRUTH,
+    );
+    t48.sampling = hp_sampling.into();
+    t48.notes = "Holds.".into();
+    let mut t49 = meta(
+        "thm-4.9-hp-w-along-l",
+        "Theorem 4.9, eq. (4.30)",
+        "Section 4.5, thesis lines 1330–1344",
+        "The w-step along ∇̂_wL (cross-fitted estimator of sepg-estimators) at the vertex and the \
+         largest step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)².",
+        DP_TRUTH,
+    );
+    t49.sampling = hp_sampling.into();
+    t49.notes = "Holds.".into();
+    let mut neg_p = meta(
+        "thm-4.7-4.9-negative-c-printed",
+        "Theorems 4.7–4.9 for C < 0, intervals (4.26), (4.29), (4.30) as printed",
+        "Section 4.5, thesis lines 1300–1344",
+        "For a bounded worsening C = −C_max/10 the end of the printed interval on the side \
+         opposite to the estimated direction realises J(θ′) − J(θ) ≥ C except with probability \
+         ≤ 1 − (1 − δ)^m.",
+        DP_TRUTH,
+    );
+    neg_p.sampling = hp_sampling.into();
+    neg_p.expected = Expected::Violated;
+    neg_p.notes = "Violated: on the side opposite to the estimate the valid linear term is \
+        −|x|(‖∇̂‖⁺)², not the printed −|x|(‖∇̂‖⁻)², so the printed end point realises less than C \
+        whenever the true gradient is larger than the lower-corrected estimate (most batches). \
+        See ERRATA.md; sepg uses the sign-aware interval (thm-4.7-4.9-negative-c-sign-aware)."
+        .into();
+    let mut neg_s = meta(
+        "thm-4.7-4.9-negative-c-sign-aware",
+        "Theorems 4.7–4.9 for C < 0 with the sign-aware interval (SPEC §4)",
+        "Section 4.5; sepg_bounds::high_probability::HpForm::SignAware",
+        "Same as thm-4.7-4.9-negative-c-printed with the sign-aware interval.",
+        DP_TRUTH,
+    );
+    neg_s.sampling = hp_sampling.into();
+    neg_s.notes = "Holds.".into();
+    let mut t312 = meta(
+        "thm-3.12-hp-adaptive-step",
+        "Theorem 3.12 (high-probability adaptive step, vertex form)",
+        "Section 3.4.1, thesis lines 660–672",
+        "With per-component t-widths, the step α* maximising the printed bound (vertex, \
+         sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
+         probability ≤ 1 − (1 − δ)^m (m = 1).",
+        DP_TRUTH,
+    );
+    t312.sampling = hp_sampling.into();
+    t312.notes = "Holds (the printed α*, with ‖∇⁻‖₁² in the denominator, is not the vertex: see \
+        ERRATA.md)."
+        .into();
+    let cheb_sampling = "lqg (clipped), γ = 0.5, σ = 1, v = −0.3, H = 20, δ = 0.2, no \
+        baseline; independent batches (one per case) of the formula's size N (at least 2)";
+    let mut c313g = meta(
+        "cor-3.13-gpomdp-batch-size",
+        "Corollary 3.13, G(PO)MDP/PGT batch size",
+        "Section 3.4.1, thesis line 680",
+        "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313g.sampling = cheb_sampling.into();
+    c313g.notes = "Holds with a large margin (Chebyshev is loose).".into();
+    let mut c313r = meta(
+        "cor-3.13-reinforce-batch-size",
+        "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
+        "Section 3.4.1, thesis line 674; Pirotta et al. 2013, Theorem 5.4",
+        "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313r.sampling = cheb_sampling.into();
+    c313r.notes = "Holds.".into();
+    let mut c313p = meta(
+        "cor-3.13-reinforce-printed",
+        "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
+        "Section 3.4.1, thesis line 674",
+        "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313p.sampling = cheb_sampling.into();
+    c313p.expected = Expected::Violated;
+    c313p.notes = "Violated: the printed count vanishes as H grows (N = 1 here; batches of 2 are \
+        used) and the error exceeds ε far more often than δ. See ERRATA.md."
+        .into();
+    let mut sum = meta(
+        "summation-theorem-pgt-gpomdp",
+        "Summation theorem: PGT = G(PO)MDP (Section 2.3.1, used in Section 3.4.1)",
+        "Section 2.3.1; sepg_estimators::Kind::{Pgt, Gpomdp}",
+        "Per trajectory, the PGT sample equals the G(PO)MDP sample (same per-step baseline), for \
+         ∇_v J and ∇_w J, to 1e-12 relative to the largest sample of the batch.",
+        "algebraic identity Σ_k ΔS_k Σ_{l≥k} F_l = Σ_l S_l F_l",
+    );
+    sum.kind = ClaimKind::Equality;
+    sum.sampling = "proptest: preset lqg or lqg1d, γ ∈ {0.99} or U[0, 0.999], σ ∈ {0.1} or \
+        U[0.05, 2], v ∈ U[−1.8, 0.2], batch seed, baseline none/mean/optimal (leave-one-out); \
+        batches of 20 trajectories"
+        .into();
+    sum.tolerance = Tolerance {
+        abs: 1e-12,
+        rel: 0.0,
+    };
+    sum.cases_full = 1000;
+    sum.cases_quick = 100;
+    sum.false_alarm_rate = "0: deterministic; rounding of 20-term sums is ≈ 1e-15 relative".into();
+    sum.notes = "Holds.".into();
+    let mut unb = meta(
+        "reinforce-gpomdp-unbiased",
+        "REINFORCE (2.1), G(PO)MDP and PGT with baselines are unbiased",
+        "Section 2.3.1–2.3.2; used by Section 4.5",
+        "E[∇̂] = ∇J for REINFORCE, G(PO)MDP, PGT with no, mean or optimal baseline \
+         (leave-one-out), for ∇_v J and ∇_w J.",
+        "closed-form J_H and gradients of the unclipped presets (ClosedFormOracle)",
+    );
+    unb.kind = ClaimKind::Equality;
+    unb.sampling = "unclipped lqg (σ = 0.5, v = −0.3) and lqg1d (σ = 1, v = −0.6), γ = 0.9, \
+        H = 20; independent batches of N = 100 (one per case); 36 components"
+        .into();
+    unb.false_alarm_rate = Z_FAR.into();
+    unb.notes = "Holds.".into();
+    let mut b1 = meta(
+        "thm-b.1-h-unbiased",
+        "Theorem B.1: ĥ of (B.3) is unbiased for h(θ)",
+        "Appendix B.1, thesis line 1756",
+        "E[ĥ] = h(θ) = ∂_σ∇_vJ + (2/σ)∇_vJ (no baseline).",
+        "exact ∇_vJ and ∂_σ∇_vJ: DP oracle (clipped) and closed form (unclipped)",
+    );
+    b1.kind = ClaimKind::Equality;
+    b1.sampling = "lqg (σ = 0.5, v = −0.3) clipped and unclipped, lqg1d (σ = 1, v = −0.6) \
+        clipped, γ = 0.9; independent batches of N = 100 (one per case)"
+        .into();
+    b1.false_alarm_rate = Z_FAR.into();
+    b1.notes = "Holds.".into();
+    let mut b2 = meta(
+        "app-b.2-baseline",
+        "Appendix B.2: the baseline b_t = b̃_t(G_t + H_t)/(G_tH_t) keeps ĥ unbiased and reduces \
+         its variance",
+        "Appendix B.2, thesis line 1814",
+        "E[ĥ_B.2] = h(θ) (leave-one-out fit of the optimal b̃_t), and the per-trajectory \
+         variance with the baseline is below the variance without.",
+        "exact h(θ) as in thm-b.1-h-unbiased; pooled sample variances",
+    );
+    b2.kind = ClaimKind::Equality;
+    b2.sampling = b1.sampling.clone();
+    b2.false_alarm_rate = Z_FAR.into();
+    b2.notes = "Holds.".into();
+    vec![
+        Check::new(t312, thm_3_12),
+        Check::new(c313g, cor_3_13_gpomdp),
+        Check::new(c313r, cor_3_13_reinforce),
+        Check::new(c313p, cor_3_13_reinforce_printed),
+        Check::new(a46, assumption_4_6),
+        Check::new(t47, thm_4_7),
+        Check::new(t48, thm_4_8),
+        Check::new(t49, thm_4_9),
+        Check::new(neg_p, negative_c_printed),
+        Check::new(neg_s, negative_c_sign_aware),
+        Check::new(sum, summation),
+        Check::new(unb, unbiased),
+        Check::new(b1, thm_b_1),
+        Check::new(b2, baseline_b_2),
+    ]
+}

@@ -1,0 +1,93 @@
+//! Ground truth on the clipped scalar LQG presets: the dynamic-programming oracle of
+//! `sepg-mdp`, the task constants the bounds use, and rollouts for the sampled checks.
+//!
+//! The bounds of Chapters 3–4 are stated for the infinite-horizon discounted J. The checks use
+//! the finite-horizon J_H = E[Σ_{t<H} γ^t r_t] (H = 20, the horizon of the experiments): it is
+//! the infinite-horizon J of the time-augmented MDP (state (s, t), zero reward and an absorbing
+//! state after H) which has the same reward bound R, the same features and action space and the
+//! same stationary Gaussian policy, so every bound applies to J_H verbatim.
+
+use sepg_bounds::constants::TaskConstants;
+use sepg_mdp::env::LqgEnv;
+use sepg_mdp::lqg_model::LqgModel;
+use sepg_mdp::oracle::{
+    ClippedDpOracle, ClosedFormOracle, ExactEval, ExactOracle, Exploration, Horizon,
+};
+
+/// Horizon of every finite-horizon J in the harness (the experiments' H).
+pub(crate) const HORIZON: usize = 20;
+
+/// Which clipped LQG preset (SPEC §1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Preset {
+    /// `lqg`: S, A = [−2, 2], reward −0.5(s² + a²).
+    Lqg,
+    /// `lqg1d`: S, A = [−4, 4], reward −0.9(s² + a²).
+    Lqg1d,
+}
+
+/// A clipped LQG preset at a discount factor γ, with its exact oracle and bound constants.
+pub(crate) struct Task {
+    pub(crate) model: LqgModel,
+    pub(crate) oracle: Box<dyn ExactOracle>,
+    pub(crate) k: TaskConstants,
+}
+
+impl Task {
+    /// The clipped preset with discount γ (DP oracle); `None` if the model, oracle or
+    /// constants reject it.
+    pub(crate) fn new(preset: Preset, gamma: f64) -> Option<Self> {
+        Self::build(preset, gamma, true)
+    }
+
+    /// The unclipped twin of the preset (closed-form oracle); its reward is unbounded, so only
+    /// estimator checks use it.
+    pub(crate) fn unclipped(preset: Preset, gamma: f64) -> Option<Self> {
+        Self::build(preset, gamma, false)
+    }
+
+    fn build(preset: Preset, gamma: f64, clipping: bool) -> Option<Self> {
+        let base = match preset {
+            Preset::Lqg => LqgModel::thesis(),
+            Preset::Lqg1d => LqgModel::lqg1d(),
+        };
+        let model = base.with_gamma(gamma).ok()?.with_clipping(clipping);
+        let oracle: Box<dyn ExactOracle> = if clipping {
+            Box::new(ClippedDpOracle::new(&model).ok()?)
+        } else {
+            Box::new(ClosedFormOracle::new(&model).ok()?)
+        };
+        let k = TaskConstants::new(
+            gamma,
+            model.r_max(),
+            model.m_phi(),
+            model.action_volume(),
+        )
+        .ok()?;
+        Some(Self { model, oracle, k })
+    }
+
+    /// Exact J_H and derivatives of the Gaussian policy N(v s, e^{2w}).
+    pub(crate) fn eval(&self, v: f64, w: f64) -> Option<ExactEval> {
+        self.oracle
+            .evaluate(
+                &[v],
+                &Exploration::Gaussian { w: vec![w] },
+                Horizon::Finite(HORIZON),
+            )
+            .ok()
+    }
+
+    /// Exact J_H only.
+    pub(crate) fn j(&self, v: f64, w: f64) -> Option<f64> {
+        self.eval(v, w).map(|e| e.j)
+    }
+
+    /// The environment for rollouts (same model, horizon H).
+    pub(crate) fn env(&self) -> Option<LqgEnv> {
+        LqgEnv::new(self.model.clone())
+            .ok()?
+            .with_horizon(HORIZON)
+            .ok()
+    }
+}
