@@ -70,6 +70,10 @@ enum Command {
     Sweep(commands::sweep::SweepArgs),
     /// Combine the shard folders of one sweep into a single sweep folder.
     Merge(commands::merge::MergeArgs),
+    /// Reproduce Table 5.1 or Figures 5.1–5.4 of the thesis (SPEC §6 protocol).
+    Reproduce(commands::reproduce::ReproduceArgs),
+    /// Plot performance, σ, v and budget of a run or sweep folder.
+    Plot(commands::plot::PlotArgs),
 }
 
 /// Parses the command line, runs the command and maps failures to exit statuses.
@@ -108,6 +112,8 @@ pub fn run() -> ExitCode {
         Command::Run(args) => commands::run::run(&args),
         Command::Sweep(args) => commands::sweep::run(&args),
         Command::Merge(args) => commands::merge::run(&args),
+        Command::Reproduce(args) => commands::reproduce::run(&args),
+        Command::Plot(args) => commands::plot::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,4 +2,8 @@
 
 mod cli_bounds;
 mod cli_exact;
+mod cli_reproduce;
+mod cli_run;
+mod cli_sweep;
 mod common;
+mod robustness;

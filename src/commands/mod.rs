@@ -3,9 +3,12 @@
 pub mod bounds;
 pub mod estimate;
 pub mod exact;
+pub mod figure;
 pub mod merge;
 pub mod parse;
+pub mod plot;
 pub mod replay;
+pub mod reproduce;
 pub mod run;
 pub mod runfmt;
 pub mod sweep;

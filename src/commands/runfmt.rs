@@ -19,7 +19,7 @@
 
 use std::fs::{self, OpenOptions};
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -1065,23 +1065,6 @@ impl Log {
             .or_else(|| self.columns.iter().position(|c| *c == format!("{name}_0")))?;
         Some(self.rows.iter().map(|r| r[idx]).collect())
     }
-}
-
-/// Every run folder at or below `dir` (a folder with a `config.toml`), sorted by path.
-pub fn find_runs(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        if d.join(CONFIG_FILE).is_file() {
-            out.push(d);
-            continue;
-        }
-        if let Ok(entries) = fs::read_dir(&d) {
-            stack.extend(entries.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
-        }
-    }
-    out.sort();
-    out
 }
 
 #[cfg(test)]

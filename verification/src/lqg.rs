@@ -57,13 +57,8 @@ impl Task {
         } else {
             Box::new(ClosedFormOracle::new(&model).ok()?)
         };
-        let k = TaskConstants::new(
-            gamma,
-            model.r_max(),
-            model.m_phi(),
-            model.action_volume(),
-        )
-        .ok()?;
+        let k =
+            TaskConstants::new(gamma, model.r_max(), model.m_phi(), model.action_volume()).ok()?;
         Some(Self { model, oracle, k })
     }
 

@@ -13,8 +13,14 @@ use crate::check::{
 };
 use crate::stats::clopper_pearson_upper;
 
-/// Maximal number of shrinking steps (bounded so that run time is bounded and deterministic).
-const MAX_SHRINK_ITERS: u32 = 16_384;
+/// Maximal number of configurations evaluated while shrinking a counterexample: beyond it every
+/// candidate is treated as passing, so shrinking ends quickly and deterministically with the
+/// smallest failing configuration found so far.
+const SHRINK_EVALUATIONS: u32 = 1024;
+
+/// proptest's own shrinking cap, far above what [`SHRINK_EVALUATIONS`] lets shrinking reach (so
+/// that proptest never prints its "Aborting shrinking" notice).
+const MAX_SHRINK_ITERS: u32 = 1 << 24;
 
 /// One comparison between the ground truth and the claimed value of a statement.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,10 +157,17 @@ where
     S::Value: Debug,
 {
     let stats = RefCell::new(Stats::default());
+    let shrink_evaluations = std::cell::Cell::new(0u32);
     let kind = ctx.kind;
     let tol = ctx.tolerance;
     let mut runner = runner(ctx);
     let result = runner.run(&strategy, |value| {
+        if stats.borrow().failed {
+            if shrink_evaluations.get() >= SHRINK_EVALUATIONS {
+                return Ok(());
+            }
+            shrink_evaluations.set(shrink_evaluations.get() + 1);
+        }
         let comparisons = eval(&value);
         let mut st = stats.borrow_mut();
         let worst = comparisons

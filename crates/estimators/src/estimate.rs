@@ -143,16 +143,9 @@ impl Estimate {
 
     /// Computes the mean and the variance from the samples and checks that all are finite.
     pub(crate) fn finish(&mut self) -> Result<(), EstimatorError> {
-        let inv_n = 1.0 / self.n as f64;
-        self.mean.fill(0.0);
-        for row in self.samples.chunks_exact(self.dim) {
-            for (m, x) in self.mean.iter_mut().zip(row) {
-                *m += x;
-            }
-        }
-        for m in &mut self.mean {
-            *m *= inv_n;
-        }
+        column_means(&self.samples, self.n, &mut self.mean);
+        self.centre.clear();
+        self.centre.extend_from_slice(&self.mean);
         self.finish_variance()
     }
 
@@ -160,22 +153,15 @@ impl Estimate {
     /// rounding), then computes the variance and checks finiteness.
     pub(crate) fn finish_with_mean(&mut self, mean: &[f64]) -> Result<(), EstimatorError> {
         self.mean.copy_from_slice(mean);
+        self.centre.resize(self.dim, 0.0);
+        column_means(&self.samples, self.n, &mut self.centre);
         self.finish_variance()
     }
 
+    /// Two-pass variance, centred on the sample mean `centre`. A non-finite sample makes its
+    /// column's variance NaN or infinite (`∞ − ∞`, NaN propagation), so checking the mean and
+    /// the variance also checks every sample.
     fn finish_variance(&mut self) -> Result<(), EstimatorError> {
-        let inv_n = 1.0 / self.n as f64;
-        // Two-pass variance, centred on the sample mean (equal to `mean` up to rounding).
-        self.centre.resize(self.dim, 0.0);
-        self.centre.fill(0.0);
-        for row in self.samples.chunks_exact(self.dim) {
-            for (c, x) in self.centre.iter_mut().zip(row) {
-                *c += x;
-            }
-        }
-        for c in &mut self.centre {
-            *c *= inv_n;
-        }
         self.variance.fill(0.0);
         for row in self.samples.chunks_exact(self.dim) {
             for ((v, x), c) in self.variance.iter_mut().zip(row).zip(&self.centre) {
@@ -187,15 +173,26 @@ impl Estimate {
             *v *= inv_dof;
         }
         let finite = |x: &f64| x.is_finite();
-        if self.mean.iter().all(finite)
-            && self.variance.iter().all(finite)
-            && self.samples.iter().all(finite)
-        {
+        if self.mean.iter().all(finite) && self.variance.iter().all(finite) {
             Ok(())
         } else {
             Err(EstimatorError::NonFinite {
                 what: "estimate (non-finite batch data or overflow)",
             })
         }
+    }
+}
+
+/// Column means of a row-major `n × dim` matrix (`dim = out.len()`), summed in row order.
+fn column_means(samples: &[f64], n: usize, out: &mut [f64]) {
+    out.fill(0.0);
+    for row in samples.chunks_exact(out.len()) {
+        for (m, x) in out.iter_mut().zip(row) {
+            *m += x;
+        }
+    }
+    let inv_n = 1.0 / n as f64;
+    for m in out.iter_mut() {
+        *m *= inv_n;
     }
 }

@@ -7,7 +7,7 @@ use sepg_mdp::Batch;
 
 use crate::error::EstimatorError;
 use crate::estimate::Estimate;
-use crate::kernel::{HTerms, ScoreTerms, Sums};
+use crate::kernel::{HMean, HOptimal, Output, Rows, Score, Sums, pgt_sample, row_sums};
 
 /// Which policy parameter a gradient is taken with respect to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -133,6 +133,8 @@ pub struct Estimator {
     sums: Sums,
     /// Per-trajectory returns (REINFORCE).
     returns: Vec<f64>,
+    /// Per-step values repeated over the components of their step.
+    bcast: Vec<f64>,
     /// Products `u = G H F` and control variates `z` of `ĥ`, per (trajectory, step, pair).
     h_u: Vec<f64>,
     h_z: Vec<f64>,
@@ -248,9 +250,7 @@ impl Estimator {
     pub fn value(&mut self, batch: &Batch, out: &mut Estimate) -> Result<(), EstimatorError> {
         validate(batch, 2)?;
         let samples = out.reset(batch.n, 1);
-        for (i, s) in samples.iter_mut().enumerate() {
-            *s = batch.discounted_return(i);
-        }
+        returns_into(batch, 0..batch.n, samples);
         out.finish()
     }
 
@@ -412,55 +412,50 @@ impl Estimator {
     ) {
         let h = batch.horizon;
         let nr = rows.len();
-        let optimal = baseline == Baseline::Optimal;
+        let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
         let scores = |p: Param| match p {
             Param::V => (&batch.cum_score_v[rows.start * h * batch.dim_v..], batch.dim_v),
             Param::W => (&batch.cum_score_w[rows.start * h * batch.dim_w..], batch.dim_w),
         };
-        let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
         match target {
             Target::Gpomdp(p) | Target::Pgt(p) => {
                 let (s, comps) = scores(p);
-                let terms = ScoreTerms {
-                    s,
-                    s_stride: h * comps,
-                    f: rewards,
-                    f_stride: h,
-                    steps: h,
-                    comps,
-                    optimal,
-                    pgt: matches!(target, Target::Pgt(_)),
-                };
-                self.sums.run(&terms, nr, baseline, fit, out);
+                let w = h * comps;
+                let s = Rows::new(s, w);
+                let f = broadcast(&mut self.bcast, rewards, h, comps);
+                if let Target::Pgt(_) = target {
+                    run_score(&mut self.sums, s, f, nr, w, comps, baseline, fit, Output::Baselines);
+                    let base = self.sums.baselines(w);
+                    let f = Rows::new(rewards, h);
+                    for (r, x) in out[..nr * comps].chunks_exact_mut(comps).enumerate() {
+                        pgt_sample(s.row(r, w), f.row(r, h), base.row(r, w), x);
+                    }
+                } else {
+                    run_score(&mut self.sums, s, f, nr, w, comps, baseline, fit, Output::Sums(out));
+                }
             }
             Target::Reinforce(p) => {
                 let (s, comps) = scores(p);
-                self.returns.clear();
-                self.returns
-                    .extend(rows.clone().map(|i| batch.discounted_return(i)));
-                let terms = ScoreTerms {
-                    s: &s[(h - 1) * comps..],
-                    s_stride: h * comps,
-                    f: &self.returns,
-                    f_stride: 1,
-                    steps: 1,
-                    comps,
-                    optimal,
-                    pgt: false,
-                };
-                self.sums.run(&terms, nr, baseline, fit, out);
+                self.returns.resize(nr, 0.0);
+                returns_into(batch, rows, &mut self.returns);
+                let s = Rows::new(&s[(h - 1) * comps..], h * comps);
+                let f = broadcast(&mut self.bcast, &self.returns, 1, comps);
+                run_score(&mut self.sums, s, f, nr, comps, comps, baseline, fit, Output::Sums(out));
             }
             Target::H => {
                 self.fill_h(batch, rows, baseline);
-                let terms = HTerms {
-                    u: &self.h_u,
-                    z: &self.h_z,
-                    f: rewards,
-                    steps: h,
-                    comps: batch.dim_w * batch.dim_v,
-                    optimal,
-                };
-                self.sums.run(&terms, nr, baseline, fit, out);
+                let comps = batch.dim_w * batch.dim_v;
+                let w = h * comps;
+                let (u, z) = (Rows::new(&self.h_u, w), Rows::new(&self.h_z, w));
+                let out = Output::Sums(out);
+                if baseline == Baseline::Mean {
+                    let f = broadcast(&mut self.bcast, rewards, h, comps);
+                    self.sums
+                        .run::<3, HMean>([u, z, f], nr, w, comps, baseline, fit, out);
+                } else {
+                    self.sums
+                        .run::<2, HOptimal>([u, z], nr, w, comps, baseline, fit, out);
+                }
             }
         }
     }
@@ -470,14 +465,41 @@ impl Estimator {
     /// entry `(r · steps + t) · dim_w · dim_v + j · dim_v + k`, where `H_j` is the cumulative
     /// w-score divided by `σ_j` (the σ-score).
     fn fill_h(&mut self, batch: &Batch, rows: Range<usize>, baseline: Baseline) {
+        match baseline {
+            Baseline::None => self.fill_h_with(batch, rows, |_, _| 0.0),
+            Baseline::Mean => self.fill_h_with(batch, rows, |g, h| g * h),
+            Baseline::Optimal => self.fill_h_with(batch, rows, |g, h| g + h),
+        }
+    }
+
+    /// [`Estimator::fill_h`] with the control variate `z = control(G_k, H_j)`.
+    #[inline(always)]
+    fn fill_h_with(
+        &mut self,
+        batch: &Batch,
+        rows: Range<usize>,
+        control: impl Fn(f64, f64) -> f64,
+    ) {
         let (h, m, l) = (batch.horizon, batch.dim_v, batch.dim_w);
         let width = l * m;
         let len = rows.len() * h * width;
+        // Every entry is overwritten.
         self.h_u.resize(len, 0.0);
         self.h_z.resize(len, 0.0);
         let g_all = &batch.cum_score_v[rows.start * h * m..rows.end * h * m];
         let w_all = &batch.cum_score_w[rows.start * h * l..rows.end * h * l];
         let f_all = &batch.disc_rewards[rows.start * h..rows.end * h];
+        if width == 1 {
+            // One action, one feature: one flat loop over all steps.
+            let sigma = batch.sigma[0];
+            let terms = g_all.iter().zip(w_all).zip(f_all);
+            for (((g, w), fr), (u, z)) in terms.zip(self.h_u.iter_mut().zip(self.h_z.iter_mut())) {
+                let hj = w / sigma;
+                *u = g * hj * fr;
+                *z = control(*g, hj);
+            }
+            return;
+        }
         for ((((g, w), fr), u), z) in g_all
             .chunks_exact(m)
             .zip(w_all.chunks_exact(l))
@@ -494,15 +516,58 @@ impl Estimator {
                 let hj = wj / sj;
                 for ((gk, uk), zk) in g.iter().zip(uj).zip(zj) {
                     *uk = gk * hj * fr;
-                    *zk = match baseline {
-                        Baseline::None => 0.0,
-                        Baseline::Mean => gk * hj,
-                        Baseline::Optimal => gk + hj,
-                    };
+                    *zk = control(*gk, hj);
                 }
             }
         }
     }
+}
+
+/// [`Sums::run`] of a score-function estimator with inputs `[s, f]`.
+#[allow(clippy::too_many_arguments)]
+fn run_score(
+    sums: &mut Sums,
+    s: Rows<'_>,
+    f: Rows<'_>,
+    rows: usize,
+    width: usize,
+    comps: usize,
+    baseline: Baseline,
+    fit: BaselineFit,
+    output: Output<'_>,
+) {
+    let inputs = [s, f];
+    if baseline == Baseline::Optimal {
+        sums
+            .run::<2, Score<true>>(inputs, rows, width, comps, baseline, fit, output);
+    } else {
+        sums
+            .run::<2, Score<false>>(inputs, rows, width, comps, baseline, fit, output);
+    }
+}
+
+/// The per-step values `values[r · steps + t]` as rows of `steps · comps` entries, each value
+/// repeated for the `comps` components of its step (no copy when `comps = 1`).
+fn broadcast<'a>(
+    buffer: &'a mut Vec<f64>,
+    values: &'a [f64],
+    steps: usize,
+    comps: usize,
+) -> Rows<'a> {
+    if comps == 1 {
+        return Rows::new(values, steps);
+    }
+    buffer.clear();
+    buffer.extend(values.iter().flat_map(|v| std::iter::repeat_n(*v, comps)));
+    Rows::new(buffer, steps * comps)
+}
+
+/// The discounted returns `Σ_t γ^t r_t` of the trajectories `rows` into `out`, summed from
+/// `−0.0` in the order of `t` (the same bits as [`Batch::discounted_return`]).
+pub(crate) fn returns_into(batch: &Batch, rows: Range<usize>, out: &mut [f64]) {
+    let h = batch.horizon;
+    let rewards = Rows::new(&batch.disc_rewards[rows.start * h..rows.end * h], h);
+    row_sums(&mut out[..rows.len()], h, -0.0, [rewards], |[f]| f);
 }
 
 /// Turns `ĥ` samples into `∂_σ ∇_v J` samples: subtracts `(2/σ_j) g_k` where `v_k` belongs to

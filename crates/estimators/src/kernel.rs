@@ -1,47 +1,144 @@
 //! The baseline-and-sample kernel shared by every likelihood-ratio estimator of this crate.
 //!
-//! Every estimator here has the form `x_{i,c} = Σ_t sample(i, t, c; b_{t,c})` with a baseline
-//! `b_{t,c} = Σ num / Σ den` summed over a set of trajectories (all of them, or all but `i`).
-//! A [`Terms`] implementation gives, per trajectory, its baseline terms and its sample; the
-//! [`Sums`] workspace runs the fit:
+//! Every estimator here has the form `x_{i,c} = Σ_t p(v_{i,t,c}; b_{t,c})`: per entry
+//! (trajectory `i`, step `t`, component `c`) a few inputs `v` (cumulative score and reward, or
+//! the products of `ĥ`), a baseline `b_{t,c} = Σ num(v) / Σ den(v)` summed over a set of
+//! trajectories (all of them, or all but `i`), and a sample term `p`. A [`Formula`] gives
+//! `num`, `den` and `p` for one entry; [`Sums::run`] runs the fit in flat passes:
 //!
-//! - plug-in: one pass accumulating the totals, then one pass of samples;
-//! - leave-one-out: one backward pass storing suffix sums over trajectories, then one forward
-//!   pass in which trajectory `i` uses `prefix_i + suffix_{i+1}`, the exact sum over the other
-//!   trajectories (no subtraction `total − own`, so no cancellation when one trajectory
-//!   dominates the sums).
+//! - no baseline: the sample terms, then the sums over time;
+//! - plug-in: the totals of the terms, the sample terms, the sums over time;
+//! - leave-one-out: one backward pass storing suffix sums over trajectories; one forward pass
+//!   in which trajectory `i` gets the baseline of `prefix_i + suffix_{i+1}`, the exact sum over
+//!   the other trajectories (no subtraction `total − own`, so no cancellation when one
+//!   trajectory dominates the sums), and its sample terms, written over `suffix_{i+1}`; the
+//!   sums over time.
 //!
-//! All loops run over contiguous slices of the row-major [`sepg_mdp::Batch`] buffers, one
-//! trajectory at a time, so that they vectorise across time steps and components.
+//! Terms are recomputed from the inputs in each pass instead of being stored. Every pass runs
+//! over contiguous rows of the row-major [`sepg_mdp::Batch`] buffers, so that it vectorises
+//! across time steps and components; the sums over time run in the order of `t` for each
+//! trajectory, four trajectories at a time (independent dependency chains).
 
 use crate::gradient::{Baseline, BaselineFit};
 
-/// The per-trajectory data of one estimator (`rows` trajectories, `width = steps · comps`
-/// baseline entries and `comps` sample components per trajectory).
-pub(crate) trait Terms {
-    /// Number of baseline entries per trajectory (`steps · comps`).
-    fn width(&self) -> usize;
-    /// Number of sample components per trajectory.
-    fn comps(&self) -> usize;
-    /// Adds the baseline terms `(num, den)` of trajectory `r` to `num` and `den`.
-    fn add_terms(&self, r: usize, num: &mut [f64], den: &mut [f64]);
-    /// Writes the sample of trajectory `r` with the baseline `base` (length `width`) into `x`.
-    fn sample(&self, r: usize, base: &[f64], x: &mut [f64]);
-    /// Writes the sample of trajectory `r` without baseline into `x`.
-    fn sample_plain(&self, r: usize, x: &mut [f64]);
+/// Row-major rows of a matrix: row `r` starts at `r · stride` (`stride = 0`: one shared row).
+#[derive(Clone, Copy)]
+pub(crate) struct Rows<'a> {
+    data: &'a [f64],
+    stride: usize,
+}
+
+impl<'a> Rows<'a> {
+    pub(crate) fn new(data: &'a [f64], stride: usize) -> Self {
+        Rows { data, stride }
+    }
+
+    #[inline(always)]
+    pub(crate) fn row(&self, r: usize, len: usize) -> &'a [f64] {
+        &self.data[r * self.stride..][..len]
+    }
+}
+
+/// The element-wise formulas of one estimator with `K` inputs per entry.
+pub(crate) trait Formula<const K: usize> {
+    /// Baseline terms `(num, den)` of one entry.
+    fn term(v: [f64; K]) -> (f64, f64);
+    /// Sample term of one entry with the baseline `b`.
+    fn sample(v: [f64; K], b: f64) -> f64;
+    /// Sample term of one entry without baseline.
+    fn plain(v: [f64; K]) -> f64;
+}
+
+/// Score-function estimators, inputs `[S, F]` (cumulative score, discounted reward or return):
+/// optimal terms `(S² F, S²)` (`OPTIMAL`) or mean terms `(F, 1)`; sample `S (F − b)`.
+pub(crate) struct Score<const OPTIMAL: bool>;
+
+impl<const OPTIMAL: bool> Formula<2> for Score<OPTIMAL> {
+    #[inline(always)]
+    fn term([s, f]: [f64; 2]) -> (f64, f64) {
+        if OPTIMAL {
+            let s2 = s * s;
+            (s2 * f, s2)
+        } else {
+            (f, 1.0)
+        }
+    }
+
+    #[inline(always)]
+    fn sample([s, f]: [f64; 2], b: f64) -> f64 {
+        s * (f - b)
+    }
+
+    #[inline(always)]
+    fn plain([s, f]: [f64; 2]) -> f64 {
+        s * f
+    }
+}
+
+/// `ĥ` with the baseline of Appendix B.2, inputs `[u, z]` (`u = G H F`, `z = G + H`): terms
+/// `(u z, z²)`, sample `u − b z`.
+pub(crate) struct HOptimal;
+
+impl Formula<2> for HOptimal {
+    #[inline(always)]
+    fn term([u, z]: [f64; 2]) -> (f64, f64) {
+        (u * z, z * z)
+    }
+
+    #[inline(always)]
+    fn sample([u, z]: [f64; 2], b: f64) -> f64 {
+        u - b * z
+    }
+
+    #[inline(always)]
+    fn plain([u, _]: [f64; 2]) -> f64 {
+        u
+    }
+}
+
+/// `ĥ` with the per-step mean baseline, inputs `[u, z, F]` (`z = G H`): terms `(F, 1)`,
+/// sample `u − b z`.
+pub(crate) struct HMean;
+
+impl Formula<3> for HMean {
+    #[inline(always)]
+    fn term([_, _, f]: [f64; 3]) -> (f64, f64) {
+        (f, 1.0)
+    }
+
+    #[inline(always)]
+    fn sample([u, z, _]: [f64; 3], b: f64) -> f64 {
+        u - b * z
+    }
+
+    #[inline(always)]
+    fn plain([u, _, _]: [f64; 3]) -> f64 {
+        u
+    }
+}
+
+/// How the samples are formed from the fitted baselines.
+pub(crate) enum Output<'a> {
+    /// `x_{r,c} = Σ_t p(v_{r,t,c}; b_{t,c})` into `rows × comps` samples.
+    Sums(&'a mut [f64]),
+    /// The baselines themselves, `rows × width`, for a sample of another order (PGT), as
+    /// `(buffer, stride)` via [`Sums::baselines`].
+    Baselines,
 }
 
 /// Reusable buffers of the baseline fit.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Sums {
-    /// Baseline of the current trajectory.
-    base: Vec<f64>,
-    /// Prefix sums (leave-one-out) or totals (plug-in) of the baseline terms.
+    /// Prefix sums (leave-one-out) or totals (plug-in) of the terms, then (plug-in) the
+    /// baseline.
     pre_num: Vec<f64>,
     pre_den: Vec<f64>,
-    /// Suffix sums over trajectories, `(rows + 1) × width` (leave-one-out).
+    /// `(rows + 1) × width`: suffix sums over trajectories (leave-one-out), row `r + 1`
+    /// overwritten by the sample terms (or baselines) of trajectory `r`.
     suf_num: Vec<f64>,
     suf_den: Vec<f64>,
+    /// Where [`Output::Baselines`] left the baselines: shared (stride 0) or per trajectory.
+    shared_base: bool,
 }
 
 fn zeroed(v: &mut Vec<f64>, len: usize) {
@@ -50,66 +147,125 @@ fn zeroed(v: &mut Vec<f64>, len: usize) {
 }
 
 impl Sums {
-    /// Writes the `rows × comps` samples of `terms` into `out` with the given baseline.
-    pub(crate) fn run<T: Terms>(
+    /// Fits the baseline of `F` over `rows` trajectories of `width` entries with inputs
+    /// `inputs`, and writes the samples (`comps` per trajectory, `width = steps · comps`) or
+    /// keeps the baselines.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn run<const K: usize, F: Formula<K>>(
         &mut self,
-        terms: &T,
+        inputs: [Rows<'_>; K],
         rows: usize,
+        width: usize,
+        comps: usize,
         baseline: Baseline,
         fit: BaselineFit,
-        out: &mut [f64],
+        output: Output<'_>,
     ) {
-        let comps = terms.comps();
-        let w = terms.width();
-        let out = &mut out[..rows * comps];
-        if baseline == Baseline::None {
-            for (r, x) in out.chunks_exact_mut(comps).enumerate() {
-                terms.sample_plain(r, x);
-            }
-            return;
-        }
-        zeroed(&mut self.base, w);
-        zeroed(&mut self.pre_num, w);
-        zeroed(&mut self.pre_den, w);
-        match fit {
-            BaselineFit::PlugIn => {
-                for r in 0..rows {
-                    terms.add_terms(r, &mut self.pre_num, &mut self.pre_den);
-                }
-                for ((b, n), d) in self.base.iter_mut().zip(&self.pre_num).zip(&self.pre_den) {
-                    *b = ratio(*n, *d);
-                }
-                for (r, x) in out.chunks_exact_mut(comps).enumerate() {
-                    terms.sample(r, &self.base, x);
-                }
-            }
-            BaselineFit::LeaveOneOut => {
-                zeroed(&mut self.suf_num, (rows + 1) * w);
-                zeroed(&mut self.suf_den, (rows + 1) * w);
-                for r in (0..rows).rev() {
-                    let (num, num_next) = self.suf_num[r * w..(r + 2) * w].split_at_mut(w);
-                    let (den, den_next) = self.suf_den[r * w..(r + 2) * w].split_at_mut(w);
-                    num.copy_from_slice(num_next);
-                    den.copy_from_slice(den_next);
-                    terms.add_terms(r, num, den);
-                }
-                for (r, x) in out.chunks_exact_mut(comps).enumerate() {
-                    let on = &self.suf_num[(r + 1) * w..(r + 2) * w];
-                    let od = &self.suf_den[(r + 1) * w..(r + 2) * w];
-                    for ((((b, pn), pd), on), od) in self
-                        .base
-                        .iter_mut()
-                        .zip(&self.pre_num)
-                        .zip(&self.pre_den)
-                        .zip(on)
-                        .zip(od)
-                    {
-                        *b = ratio(pn + on, pd + od);
+        let w = width;
+        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
+        let keep_base = matches!(output, Output::Baselines);
+        // Row r + 1 of `suf_num` receives trajectory r's sample terms (or baselines).
+        self.suf_num.resize((rows + 1) * w, 0.0);
+        self.shared_base = false;
+        match (baseline, fit) {
+            (Baseline::None, _) => {
+                if keep_base {
+                    self.suf_num.fill(0.0);
+                    self.shared_base = true;
+                } else {
+                    for (r, p) in self.suf_num[w..].chunks_exact_mut(w).enumerate() {
+                        let v = row(r);
+                        for (e, p) in p.iter_mut().enumerate() {
+                            *p = F::plain(std::array::from_fn(|k| v[k][e]));
+                        }
                     }
-                    terms.add_terms(r, &mut self.pre_num, &mut self.pre_den);
-                    terms.sample(r, &self.base, x);
                 }
             }
+            (_, BaselineFit::PlugIn) => {
+                zeroed(&mut self.pre_num, w);
+                zeroed(&mut self.pre_den, w);
+                for r in 0..rows {
+                    let v = row(r);
+                    for (e, (pn, pd)) in self.pre_num.iter_mut().zip(&mut self.pre_den).enumerate() {
+                        let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
+                        *pn += n;
+                        *pd += d;
+                    }
+                }
+                for (b, d) in self.pre_num.iter_mut().zip(&self.pre_den) {
+                    *b = ratio(*b, *d);
+                }
+                if keep_base {
+                    self.suf_num[..w].copy_from_slice(&self.pre_num);
+                    self.shared_base = true;
+                } else {
+                    for (r, p) in self.suf_num[w..].chunks_exact_mut(w).enumerate() {
+                        let v = row(r);
+                        for (e, (p, b)) in p.iter_mut().zip(&self.pre_num).enumerate() {
+                            *p = F::sample(std::array::from_fn(|k| v[k][e]), *b);
+                        }
+                    }
+                }
+            }
+            (_, BaselineFit::LeaveOneOut) => {
+                self.suf_den.resize((rows + 1) * w, 0.0);
+                // Rows 0..rows are overwritten; row `rows` is the empty sum.
+                self.suf_num[rows * w..].fill(0.0);
+                self.suf_den[rows * w..].fill(0.0);
+                for r in (0..rows).rev() {
+                    let v = row(r);
+                    let (sn, sn_next) = self.suf_num[r * w..(r + 2) * w].split_at_mut(w);
+                    let (sd, sd_next) = self.suf_den[r * w..(r + 2) * w].split_at_mut(w);
+                    let next = sn_next.iter().zip(sd_next.iter());
+                    for (e, ((sn, sd), (nn, nd))) in sn.iter_mut().zip(sd).zip(next).enumerate() {
+                        let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
+                        *sn = nn + n;
+                        *sd = nd + d;
+                    }
+                }
+                zeroed(&mut self.pre_num, w);
+                zeroed(&mut self.pre_den, w);
+                let others = self.suf_num[w..]
+                    .chunks_exact_mut(w)
+                    .zip(self.suf_den[w..].chunks_exact(w));
+                for (r, (on, od)) in others.enumerate() {
+                    let v = row(r);
+                    let pre = self.pre_num.iter_mut().zip(self.pre_den.iter_mut());
+                    for (e, ((p, od), (pn, pd))) in on.iter_mut().zip(od).zip(pre).enumerate() {
+                        let ve = std::array::from_fn(|k| v[k][e]);
+                        let b = ratio(*pn + *p, *pd + od);
+                        let (n, d) = F::term(ve);
+                        *pn += n;
+                        *pd += d;
+                        *p = if keep_base { b } else { F::sample(ve, b) };
+                    }
+                }
+            }
+        }
+        if let Output::Sums(out) = output {
+            let terms = &self.suf_num[w..];
+            if comps == 1 {
+                row_sums(&mut out[..rows], w, 0.0, [Rows::new(terms, w)], |[p]| p);
+            } else {
+                for (x, p) in out[..rows * comps].chunks_exact_mut(comps).zip(terms.chunks_exact(w)) {
+                    x.fill(0.0);
+                    for pt in p.chunks_exact(comps) {
+                        for (xc, pc) in x.iter_mut().zip(pt) {
+                            *xc += pc;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The baselines left by [`Output::Baselines`]: trajectory `r` uses
+    /// `buffer[r · stride..][..width]`.
+    pub(crate) fn baselines(&self, width: usize) -> Rows<'_> {
+        if self.shared_base {
+            Rows::new(&self.suf_num[..width], 0)
+        } else {
+            Rows::new(&self.suf_num[width..], width)
         }
     }
 }
@@ -117,129 +273,51 @@ impl Sums {
 /// Baseline ratio with the explicit convention `0/0 = 0` (Sec 2.3.2, SPEC §3); written as a
 /// select after the division so that it vectorises.
 #[inline(always)]
-pub(crate) fn ratio(num: f64, den: f64) -> f64 {
+fn ratio(num: f64, den: f64) -> f64 {
     let q = num / den;
     if den > 0.0 { q } else { 0.0 }
 }
 
-/// Score-function terms: G(PO)MDP and PGT (per step) or REINFORCE (one "step", the last
-/// cumulative score and the return).
-///
-/// Trajectory `r` has cumulative scores `s[r · s_stride ..][.. steps · comps]` and rewards
-/// `f[r · f_stride ..][.. steps]`.
-pub(crate) struct ScoreTerms<'a> {
-    pub s: &'a [f64],
-    pub s_stride: usize,
-    pub f: &'a [f64],
-    pub f_stride: usize,
-    pub steps: usize,
-    pub comps: usize,
-    /// Optimal `(S² F, S²)` terms, else mean `(F, 1)` terms.
-    pub optimal: bool,
-    /// PGT (reward-to-go) order of the sample.
-    pub pgt: bool,
-}
-
-impl ScoreTerms<'_> {
-    #[inline(always)]
-    fn rows(&self, r: usize) -> (&[f64], &[f64]) {
-        let s = &self.s[r * self.s_stride..][..self.steps * self.comps];
-        let f = &self.f[r * self.f_stride..][..self.steps];
-        (s, f)
-    }
-}
-
-impl Terms for ScoreTerms<'_> {
-    fn width(&self) -> usize {
-        self.steps * self.comps
-    }
-
-    fn comps(&self) -> usize {
-        self.comps
-    }
-
-    #[inline]
-    fn add_terms(&self, r: usize, num: &mut [f64], den: &mut [f64]) {
-        let (s, f) = self.rows(r);
-        let (num, den) = (&mut num[..s.len()], &mut den[..s.len()]);
-        if self.comps == 1 {
-            for (((n, d), sc), ft) in num.iter_mut().zip(den.iter_mut()).zip(s).zip(f) {
-                add_score_term(self.optimal, *sc, *ft, n, d);
-            }
-        } else {
-            let c = self.comps;
-            for (((nt, dt), st), ft) in num
-                .chunks_exact_mut(c)
-                .zip(den.chunks_exact_mut(c))
-                .zip(s.chunks_exact(c))
-                .zip(f)
-            {
-                for ((n, d), sc) in nt.iter_mut().zip(dt.iter_mut()).zip(st) {
-                    add_score_term(self.optimal, *sc, *ft, n, d);
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn sample(&self, r: usize, base: &[f64], x: &mut [f64]) {
-        let (s, f) = self.rows(r);
-        if self.pgt {
-            pgt_sample(s, f, base, x);
-        } else if self.comps == 1 {
-            let mut acc = 0.0;
-            for ((sc, bc), ft) in s.iter().zip(base).zip(f) {
-                acc += sc * (ft - bc);
-            }
-            x[0] = acc;
-        } else {
-            x.fill(0.0);
-            let c = self.comps;
-            for ((st, bt), ft) in s.chunks_exact(c).zip(base.chunks_exact(c)).zip(f) {
-                for ((xc, sc), bc) in x.iter_mut().zip(st).zip(bt) {
-                    *xc += sc * (ft - bc);
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn sample_plain(&self, r: usize, x: &mut [f64]) {
-        let (s, f) = self.rows(r);
-        if self.pgt {
-            pgt_plain(s, f, x);
-        } else if self.comps == 1 {
-            let mut acc = 0.0;
-            for (sc, ft) in s.iter().zip(f) {
-                acc += sc * ft;
-            }
-            x[0] = acc;
-        } else {
-            x.fill(0.0);
-            for (st, ft) in s.chunks_exact(self.comps).zip(f) {
-                for (xc, sc) in x.iter_mut().zip(st) {
-                    *xc += sc * ft;
-                }
-            }
-        }
-    }
-}
-
-/// Adds `(S² F, S²)` (optimal) or `(F, 1)` (mean) to `(n, d)`.
+/// `out[r] = init + Σ_{t<len} term(a_{r,t}, b_{r,t}, …)`, summed in the order of `t` for every
+/// row `r`, four rows at a time (independent dependency chains; the result does not depend on
+/// the blocking).
 #[inline(always)]
-fn add_score_term(optimal: bool, s: f64, f: f64, n: &mut f64, d: &mut f64) {
-    if optimal {
-        let s2 = s * s;
-        *n += s2 * f;
-        *d += s2;
-    } else {
-        *n += f;
-        *d += 1.0;
+pub(crate) fn row_sums<const A: usize>(
+    out: &mut [f64],
+    len: usize,
+    init: f64,
+    inputs: [Rows<'_>; A],
+    term: impl Fn([f64; A]) -> f64,
+) {
+    const BLOCK: usize = 4;
+    let mut blocks = out.chunks_exact_mut(BLOCK);
+    let mut r = 0;
+    for x in &mut blocks {
+        let rows: [[&[f64]; BLOCK]; A] =
+            std::array::from_fn(|a| std::array::from_fn(|q| inputs[a].row(r + q, len)));
+        let mut acc = [init; BLOCK];
+        for t in 0..len {
+            for (q, acc) in acc.iter_mut().enumerate() {
+                *acc += term(std::array::from_fn(|a| rows[a][q][t]));
+            }
+        }
+        x.copy_from_slice(&acc);
+        r += BLOCK;
+    }
+    for x in blocks.into_remainder() {
+        let rows: [&[f64]; A] = std::array::from_fn(|a| inputs[a].row(r, len));
+        let mut acc = init;
+        for t in 0..len {
+            acc += term(std::array::from_fn(|a| rows[a][t]));
+        }
+        *x = acc;
+        r += 1;
     }
 }
 
-/// PGT order for one trajectory: `x_c = Σ_k (S_k − S_{k−1})_c Σ_{l≥k} (F_l − b_{l,c})`.
-fn pgt_sample(s: &[f64], f: &[f64], base: &[f64], x: &mut [f64]) {
+/// PGT order for one trajectory: `x_c = Σ_k (S_k − S_{k−1})_c Σ_{l≥k} (F_l − b_{l,c})`, with
+/// cumulative scores `s` (`steps × comps`), rewards `f` and baselines `base`.
+pub(crate) fn pgt_sample(s: &[f64], f: &[f64], base: &[f64], x: &mut [f64]) {
     let comps = x.len();
     for (c, xc) in x.iter_mut().enumerate() {
         let mut acc = 0.0;
@@ -250,113 +328,5 @@ fn pgt_sample(s: &[f64], f: &[f64], base: &[f64], x: &mut [f64]) {
             acc += (s[t * comps + c] - prev) * to_go;
         }
         *xc = acc;
-    }
-}
-
-/// [`pgt_sample`] without baseline.
-fn pgt_plain(s: &[f64], f: &[f64], x: &mut [f64]) {
-    let comps = x.len();
-    for (c, xc) in x.iter_mut().enumerate() {
-        let mut acc = 0.0;
-        let mut to_go = 0.0;
-        for t in (0..f.len()).rev() {
-            to_go += f[t];
-            let prev = if t == 0 { 0.0 } else { s[(t - 1) * comps + c] };
-            acc += (s[t * comps + c] - prev) * to_go;
-        }
-        *xc = acc;
-    }
-}
-
-/// The terms of `ĥ` (Theorem B.1) from per-entry products `u = G H F` and control variates
-/// `z` (`G + H` for the optimal baseline of Appendix B.2, `G H` for the mean baseline),
-/// precomputed for the trajectories of the range, layout `[(r · steps + t) · comps + c]`.
-pub(crate) struct HTerms<'a> {
-    pub u: &'a [f64],
-    pub z: &'a [f64],
-    /// Rewards `F` of the trajectories of the range, `[r · steps + t]`.
-    pub f: &'a [f64],
-    pub steps: usize,
-    pub comps: usize,
-    /// Optimal `(u z, z²)` terms, else mean `(F, 1)` terms.
-    pub optimal: bool,
-}
-
-impl Terms for HTerms<'_> {
-    fn width(&self) -> usize {
-        self.steps * self.comps
-    }
-
-    fn comps(&self) -> usize {
-        self.comps
-    }
-
-    #[inline]
-    fn add_terms(&self, r: usize, num: &mut [f64], den: &mut [f64]) {
-        let w = self.width();
-        let (num, den) = (&mut num[..w], &mut den[..w]);
-        if self.optimal {
-            let u = &self.u[r * w..][..w];
-            let z = &self.z[r * w..][..w];
-            for (((n, d), u), z) in num.iter_mut().zip(den.iter_mut()).zip(u).zip(z) {
-                *n += u * z;
-                *d += z * z;
-            }
-        } else {
-            let f = &self.f[r * self.steps..][..self.steps];
-            for ((nt, dt), ft) in num
-                .chunks_exact_mut(self.comps)
-                .zip(den.chunks_exact_mut(self.comps))
-                .zip(f)
-            {
-                for (n, d) in nt.iter_mut().zip(dt.iter_mut()) {
-                    *n += ft;
-                    *d += 1.0;
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn sample(&self, r: usize, base: &[f64], x: &mut [f64]) {
-        let w = self.width();
-        let u = &self.u[r * w..][..w];
-        let z = &self.z[r * w..][..w];
-        if self.comps == 1 {
-            let mut acc = 0.0;
-            for ((u, z), b) in u.iter().zip(z).zip(base) {
-                acc += u - b * z;
-            }
-            x[0] = acc;
-        } else {
-            x.fill(0.0);
-            let c = self.comps;
-            for ((ut, zt), bt) in u.chunks_exact(c).zip(z.chunks_exact(c)).zip(base.chunks_exact(c))
-            {
-                for (((xc, u), z), b) in x.iter_mut().zip(ut).zip(zt).zip(bt) {
-                    *xc += u - b * z;
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn sample_plain(&self, r: usize, x: &mut [f64]) {
-        let w = self.width();
-        let u = &self.u[r * w..][..w];
-        if self.comps == 1 {
-            let mut acc = 0.0;
-            for u in u {
-                acc += u;
-            }
-            x[0] = acc;
-        } else {
-            x.fill(0.0);
-            for ut in u.chunks_exact(self.comps) {
-                for (xc, u) in x.iter_mut().zip(ut) {
-                    *xc += u;
-                }
-            }
-        }
     }
 }

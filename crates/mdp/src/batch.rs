@@ -70,28 +70,33 @@ impl Batch {
     }
 
     /// Discounted rewards `γ^t r_t` of trajectory `i` (length `horizon`).
+    #[inline]
     pub fn rewards(&self, i: usize) -> &[f64] {
         &self.disc_rewards[i * self.horizon..(i + 1) * self.horizon]
     }
 
     /// Cumulative v-score of trajectory `i` at step `t` (length `dim_v`).
+    #[inline]
     pub fn score_v(&self, i: usize, t: usize) -> &[f64] {
         let o = (i * self.horizon + t) * self.dim_v;
         &self.cum_score_v[o..o + self.dim_v]
     }
 
     /// Cumulative w-score of trajectory `i` at step `t` (length `dim_w`).
+    #[inline]
     pub fn score_w(&self, i: usize, t: usize) -> &[f64] {
         let o = (i * self.horizon + t) * self.dim_w;
         &self.cum_score_w[o..o + self.dim_w]
     }
 
     /// Discounted return `Σ_t γ^t r_t` of trajectory `i`.
+    #[inline]
     pub fn discounted_return(&self, i: usize) -> f64 {
         self.rewards(i).iter().sum()
     }
 
     /// Total number of environment steps in the batch (`Σ_i len_i`).
+    #[inline]
     pub fn steps(&self) -> usize {
         self.lengths.iter().sum()
     }

@@ -147,9 +147,10 @@ fn sampled_violations(ctx: &CheckContext<'_>) -> Evaluation {
                 Requirement::Mi => j.windows(2).fold((0, 0), |(v, n), w| {
                     (v + u64::from(w[1] < w[0] - tol), n + 1)
                 }),
-                _ => j.iter().skip(1).fold((0, 0), |(v, n), x| {
-                    (v + u64::from(*x < j[0] - tol), n + 1)
-                }),
+                _ => j
+                    .iter()
+                    .skip(1)
+                    .fold((0, 0), |(v, n), x| (v + u64::from(*x < j[0] - tol), n + 1)),
             };
             tests.push(Freq {
                 name: format!("{preset:?} σ⁰ = 1, δ = {delta}, {name}"),
@@ -165,11 +166,14 @@ fn sampled_violations(ctx: &CheckContext<'_>) -> Evaluation {
 fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
     let gamma: f64 = 0.99;
     let v_star = (1.0 - (1.0 + 4.0 * gamma * gamma).sqrt()) / (2.0 * gamma);
-    let mut comparisons = vec![("v* = (1 − √(1+4γ²))/(2γ) vs printed −0.615".to_string(), Comparison::new(v_star, -0.615))];
+    let mut comparisons = vec![(
+        "v* = (1 − √(1+4γ²))/(2γ) vs printed −0.615".to_string(),
+        Comparison::new(v_star, -0.615),
+    )];
     let mut figures = Vec::new();
     for (preset, model) in [("lqg", LqgModel::thesis()), ("lqg1d", LqgModel::lqg1d())] {
-        let Ok(opt) = ClosedFormOracle::new(&model.with_clipping(false))
-            .and_then(|o| o.optimal_gain())
+        let Ok(opt) =
+            ClosedFormOracle::new(&model.with_clipping(false)).and_then(|o| o.optimal_gain())
         else {
             continue;
         };
@@ -197,7 +201,15 @@ fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
 fn final_error(req: Requirement, sigma0: f64, iterations: u64) -> Option<f64> {
     let gamma: f64 = 0.99;
     let v_star = (1.0 - (1.0 + 4.0 * gamma * gamma).sqrt()) / (2.0 * gamma);
-    let records = run(Preset::Lqg1d, false, req, sigma0, GradientMode::Exact, iterations, 0)?;
+    let records = run(
+        Preset::Lqg1d,
+        false,
+        req,
+        sigma0,
+        GradientMode::Exact,
+        iterations,
+        0,
+    )?;
     let last = records.last()?;
     Some((last.v[0] - v_star).abs())
 }
@@ -216,14 +228,31 @@ fn table_5_1(ctx: &CheckContext<'_>) -> Evaluation {
     let mut eval = fixed(
         ctx,
         &[
-            ("|v−v*|: LB-I (σ⁰ = 1) ≤ MI (σ⁰ = 1)".into(), Comparison::new(lb1, mi)),
-            ("|v−v*|: LB-II ≤ LB-I (σ⁰ = 1)".into(), Comparison::new(lb2, lb1)),
-            ("|v−v*|: LB-II σ⁰ = 1 ≤ LB-II σ⁰ = 0.1".into(), Comparison::new(lb2, lb2_small)),
+            (
+                "|v−v*|: LB-I (σ⁰ = 1) ≤ MI (σ⁰ = 1)".into(),
+                Comparison::new(lb1, mi),
+            ),
+            (
+                "|v−v*|: LB-II ≤ LB-I (σ⁰ = 1)".into(),
+                Comparison::new(lb2, lb1),
+            ),
+            (
+                "|v−v*|: LB-II σ⁰ = 1 ≤ LB-II σ⁰ = 0.1".into(),
+                Comparison::new(lb2, lb2_small),
+            ),
         ],
     );
     eval.figures.push(Figure {
-        name: format!("|v_T − v*| after T = {t} exact iterations: MI, LB-I, LB-II, LB-II (σ⁰ = 0.1)"),
-        value: format!("{}, {}, {}, {}", fmt_f64(mi), fmt_f64(lb1), fmt_f64(lb2), fmt_f64(lb2_small)),
+        name: format!(
+            "|v_T − v*| after T = {t} exact iterations: MI, LB-I, LB-II, LB-II (σ⁰ = 0.1)"
+        ),
+        value: format!(
+            "{}, {}, {}, {}",
+            fmt_f64(mi),
+            fmt_f64(lb1),
+            fmt_f64(lb2),
+            fmt_f64(lb2_small)
+        ),
     });
     eval
 }

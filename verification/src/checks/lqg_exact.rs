@@ -88,7 +88,7 @@ fn ratio_figure(cell: &Cell<f64>, what: &str) -> Figure {
     Figure {
         name: format!(
             "max over cases of the effective penalty / the bound's penalty {what} (the bound \
-             would still hold with the penalty divided by 1/this)"
+             still holds on every case with its penalty multiplied by this)"
         ),
         value: fmt_f64(cell.get()),
     }
@@ -128,7 +128,12 @@ fn thm_4_2(ctx: &CheckContext<'_>) -> Evaluation {
                 return vec![];
             };
             let truth = j1 - e.j;
-            record_ratio(&ratio, alpha * g[0] * g[0], truth, alpha * alpha * cc * g[0] * g[0]);
+            record_ratio(
+                &ratio,
+                alpha * g[0] * g[0],
+                truth,
+                alpha * alpha * cc * g[0] * g[0],
+            );
             out.push(Comparison::new(truth, bound));
             out.push(Comparison::new(truth, required));
         }
@@ -295,7 +300,10 @@ fn w_update_along_j(ctx: &CheckContext<'_>, rigorous_form: bool) -> Evaluation {
             let truth = j1 - e.j;
             record_ratio(&ratio, beta * gw * gw, truth, beta * beta * dd * gw * gw);
             gap.set(gap.get().max((thesis - rig) / c_max));
-            out.push(Comparison::new(truth, if rigorous_form { rig } else { thesis }));
+            out.push(Comparison::new(
+                truth,
+                if rigorous_form { rig } else { thesis },
+            ));
             out.push(Comparison::new(truth, required));
         }
         out

@@ -199,7 +199,8 @@ fn z_outcome(tests: &[ZTest]) -> Evaluation {
                 fmt_f64(z)
             ),
         });
-        if !(z.abs() <= z_crit) && worst.as_ref().is_none_or(|(a, _)| z.abs() > *a) {
+        let rejected = z.is_nan() || z.abs() > z_crit;
+        if rejected && worst.as_ref().is_none_or(|(a, _)| z.abs() > *a) {
             worst = Some((
                 z.abs(),
                 format!(
@@ -265,12 +266,10 @@ fn assumption_4_6(ctx: &CheckContext<'_>) -> Evaluation {
             let Some(batch) = s.batch(N, ctx.seed ^ si as u64, b) else {
                 continue;
             };
-            for (p, (param, truth)) in [
-                (Param::V, s.exact.grad_v[0]),
-                (Param::W, s.exact.grad_w[0]),
-            ]
-            .into_iter()
-            .enumerate()
+            for (p, (param, truth)) in
+                [(Param::V, s.exact.grad_v[0]), (Param::W, s.exact.grad_w[0])]
+                    .into_iter()
+                    .enumerate()
             {
                 let Some(e) = estimate(&mut est, &batch, param, GradientSpec::default()) else {
                     continue;
@@ -331,7 +330,9 @@ fn hp_counts(
     batches: u32,
 ) -> Vec<(u64, u64, &'static str)> {
     let mut counts = match req {
-        Requirement::NonNegative => vec![(0, 0, "C = 0, largest step"), (0, 0, "C = C_max, vertex")],
+        Requirement::NonNegative => {
+            vec![(0, 0, "C = 0, largest step"), (0, 0, "C = C_max, vertex")]
+        }
         Requirement::Negative => vec![(0, 0, "C = −C_max/10, step opposite to the estimate")],
     };
     let mut est = Estimator::new();
@@ -374,7 +375,14 @@ fn hp_counts(
                 };
                 let gl = sur.grad_w_l().mean()[0];
                 (
-                    HighProbabilityBound::w_along_l(s.k(), s.sigma, gw.mean()[0], cw.eps, gl, cl.eps),
+                    HighProbabilityBound::w_along_l(
+                        s.k(),
+                        s.sigma,
+                        gw.mean()[0],
+                        cw.eps,
+                        gl,
+                        cl.eps,
+                    ),
                     gl,
                 )
             }
@@ -440,7 +448,9 @@ fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirem
             let counts = hp_counts(&s, which, form, req, delta, ctx.seed ^ si as u64, ctx.cases);
             for (violations, trials, label) in counts {
                 tests.push(Freq {
-                    name: format!("{which:?} on {preset:?} σ = {sigma}, v = {v}, δ = {delta}, {label}"),
+                    name: format!(
+                        "{which:?} on {preset:?} σ = {sigma}, v = {v}, δ = {delta}, {label}"
+                    ),
                     violations,
                     trials,
                     allowed: allowed(which, delta),
@@ -464,11 +474,21 @@ fn thm_4_9(ctx: &CheckContext<'_>) -> Evaluation {
 }
 
 fn negative_c_printed(ctx: &CheckContext<'_>) -> Evaluation {
-    hp_check(ctx, &[Hp::V, Hp::WJ, Hp::WL], HpForm::Thesis, Requirement::Negative)
+    hp_check(
+        ctx,
+        &[Hp::V, Hp::WJ, Hp::WL],
+        HpForm::Thesis,
+        Requirement::Negative,
+    )
 }
 
 fn negative_c_sign_aware(ctx: &CheckContext<'_>) -> Evaluation {
-    hp_check(ctx, &[Hp::V, Hp::WJ, Hp::WL], HpForm::SignAware, Requirement::Negative)
+    hp_check(
+        ctx,
+        &[Hp::V, Hp::WJ, Hp::WL],
+        HpForm::SignAware,
+        Requirement::Negative,
+    )
 }
 
 fn thm_3_12(ctx: &CheckContext<'_>) -> Evaluation {
@@ -602,42 +622,54 @@ fn summation(ctx: &CheckContext<'_>) -> Evaluation {
         prop_oneof![Just(0.1), 0.05..2.0f64],
         -1.8..0.2f64,
         any::<u64>(),
-        prop_oneof![Just(Baseline::None), Just(Baseline::Mean), Just(Baseline::Optimal)],
+        prop_oneof![
+            Just(Baseline::None),
+            Just(Baseline::Mean),
+            Just(Baseline::Optimal)
+        ],
     );
-    search(ctx, strategy, |&(preset, gamma, sigma, v, seed, baseline)| {
-        let Some(task) = Task::new(preset, gamma) else {
-            return vec![];
-        };
-        let (Some(env), Ok(policy)) = (task.env(), GaussianPolicy::scalar(v, sigma.ln())) else {
-            return vec![];
-        };
-        let Ok(batch) = rollout(&env, &policy, 20, HORIZON, SeedKey::new(seed, 0, 0)) else {
-            return vec![];
-        };
-        let mut est = Estimator::new();
-        let mut out = Vec::new();
-        for param in [Param::V, Param::W] {
-            let spec = |kind| GradientSpec {
-                kind,
-                baseline,
-                fit: BaselineFit::LeaveOneOut,
-            };
-            let (Some(p), Some(g)) = (
-                estimate(&mut est, &batch, param, spec(Kind::Pgt)),
-                estimate(&mut est, &batch, param, spec(Kind::Gpomdp)),
-            ) else {
+    search(
+        ctx,
+        strategy,
+        |&(preset, gamma, sigma, v, seed, baseline)| {
+            let Some(task) = Task::new(preset, gamma) else {
                 return vec![];
             };
-            let scale = g.samples().iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
-            out.extend(
-                p.samples()
+            let (Some(env), Ok(policy)) = (task.env(), GaussianPolicy::scalar(v, sigma.ln()))
+            else {
+                return vec![];
+            };
+            let Ok(batch) = rollout(&env, &policy, 20, HORIZON, SeedKey::new(seed, 0, 0)) else {
+                return vec![];
+            };
+            let mut est = Estimator::new();
+            let mut out = Vec::new();
+            for param in [Param::V, Param::W] {
+                let spec = |kind| GradientSpec {
+                    kind,
+                    baseline,
+                    fit: BaselineFit::LeaveOneOut,
+                };
+                let (Some(p), Some(g)) = (
+                    estimate(&mut est, &batch, param, spec(Kind::Pgt)),
+                    estimate(&mut est, &batch, param, spec(Kind::Gpomdp)),
+                ) else {
+                    return vec![];
+                };
+                let scale = g
+                    .samples()
                     .iter()
-                    .zip(g.samples())
-                    .map(|(a, b)| Comparison::new(a / scale, b / scale)),
-            );
-        }
-        out
-    })
+                    .fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+                out.extend(
+                    p.samples()
+                        .iter()
+                        .zip(g.samples())
+                        .map(|(a, b)| Comparison::new(a / scale, b / scale)),
+                );
+            }
+            out
+        },
+    )
 }
 
 /// Batch means of one estimator over `batches` independent batches.
@@ -664,10 +696,8 @@ fn unbiased(ctx: &CheckContext<'_>) -> Evaluation {
         };
         for kind in [Kind::Reinforce, Kind::Gpomdp, Kind::Pgt] {
             for baseline in [Baseline::None, Baseline::Mean, Baseline::Optimal] {
-                for (param, truth) in [
-                    (Param::V, s.exact.grad_v[0]),
-                    (Param::W, s.exact.grad_w[0]),
-                ] {
+                for (param, truth) in [(Param::V, s.exact.grad_v[0]), (Param::W, s.exact.grad_w[0])]
+                {
                     let spec = GradientSpec {
                         kind,
                         baseline,
@@ -742,9 +772,15 @@ fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
         });
         let ratio = var_opt / var_none;
         worst_ratio = worst_ratio.max(ratio);
-        let _ = write!(ratios, "{preset:?} clipped = {clipped}: {}; ", fmt_f64(ratio));
+        let _ = write!(
+            ratios,
+            "{preset:?} clipped = {clipped}: {}; ",
+            fmt_f64(ratio)
+        );
         tests.push(ZTest {
-            name: format!("{preset:?} clipped = {clipped}, σ = {sigma}, v = {v}: ĥ with baseline B.2"),
+            name: format!(
+                "{preset:?} clipped = {clipped}, σ = {sigma}, v = {v}: ĥ with baseline B.2"
+            ),
             samples,
             truth: exact_h(&s),
         });
@@ -754,7 +790,9 @@ fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
         name: "per-trajectory variance with the B.2 baseline / without".into(),
         value: ratios,
     });
-    if !matches!(eval.outcome, Outcome::Violated { .. }) && !(worst_ratio < 1.0) {
+    if !matches!(eval.outcome, Outcome::Violated { .. })
+        && (worst_ratio.is_nan() || worst_ratio >= 1.0)
+    {
         eval.outcome = Outcome::Violated {
             counterexample: format!("variance ratio {} ≥ 1", fmt_f64(worst_ratio)),
             amount: worst_ratio - 1.0,
@@ -773,7 +811,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
         sampling: String::new(),
         kind: ClaimKind::UpperBound,
         cases_full: 2000,
-        cases_quick: 300,
+        cases_quick: 200,
         tolerance: Tolerance { abs: 0.0, rel: 0.0 },
         false_alarm_rate: format!(
             "{FAMILY_ALPHA} family-wise: one-sided Clopper–Pearson test of each claimed rate, \
@@ -807,7 +845,13 @@ pub(crate) fn checks() -> Vec<Check> {
         independent batches (one per case)"
         .into();
     a46.cases_quick = 2000;
-    a46.notes = "Measured; the t-interval relies on the central limit theorem (the thesis says so).".into();
+    a46.expected = Expected::Violated;
+    a46.notes = "Violated: at N = 100 the t-interval under-covers (realised miss rates up to \
+        0.085 for δ = 0.05 and 0.236 for δ = 0.2): the returns and scores are skewed and \
+        heavy-tailed, and the t-interval is only asymptotically valid, as Section 4.5 concedes. \
+        The high-probability guarantees built on it still hold on these tasks \
+        (thm-4.7-hp-v-update, …) because the bounds are conservative. See ERRATA.md."
+        .into();
     let mut t47 = meta(
         "thm-4.7-hp-v-update",
         "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, SPEC §4 vertex)",

@@ -12,7 +12,7 @@
 //! its noise (signal ≈ 1e-10 against a per-block standard error ≈ 5e-9), so σ only drifts.
 //! Adam follows ∇_w J < 0 (every unit of noise costs penalty) and shrinks σ at every step.
 //!
-//! The short test runs in a few seconds; the per-seed study is `#[ignore]`d (about 4
+//! The short test runs in a few seconds; the per-seed study is `#[ignore]`d (about 6
 //! minutes): `cargo test -p sepg-algo --release --test lib -- --ignored --nocapture mountain`.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::record::Record;
@@ -80,7 +80,7 @@ fn zv_keeps_sigma_while_adam_shrinks_it() {
 }
 
 #[test]
-#[ignore = "about 4 minutes: 5 seeds x (SEPG-ZV, Adam) x 2000 iterations of N = 100, H = 999"]
+#[ignore = "about 6 minutes: 5 seeds x (SEPG-ZV, Adam) x 2000 iterations of N = 100, H = 999"]
 fn fig_5_4_protocol_per_seed() {
     let iterations = 2000;
     for seed in 0..5 {

@@ -209,6 +209,69 @@ pub enum OracleError {
     },
 }
 
+/// Which derivatives an evaluation must return ([`ExactOracle::evaluate_with`]); `J` is
+/// always computed.
+///
+/// One SEPG iteration in exact mode (SPEC §5, thesis Sec 4.3) needs `∇_v J` for the mean step
+/// (Theorem 4.3), and `∇_w J` with `∇_w ∇_v J` for the exploration step (the surrogate
+/// gradient `∇_w L` of Corollary 4.4 / Appendix B), but never the Hessian; the target policy
+/// of LV / ZV needs `J` only.
+///
+/// # Formula
+/// ```text
+/// grad_v: ∇_v J    grad_w: ∇_w J    mixed: ∇_w ∇_v J    hessian: ∇²_{(v,w)} J
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs {
+    /// `∇_v J`.
+    pub grad_v: bool,
+    /// `∇_w J`.
+    pub grad_w: bool,
+    /// `∇_w ∇_v J`.
+    pub mixed: bool,
+    /// The Hessian in `(v, w)`.
+    pub hessian: bool,
+}
+
+impl Needs {
+    /// `J` only.
+    ///
+    /// ```
+    /// assert!(!sepg_mdp::oracle::Needs::VALUE.grad_v);
+    /// ```
+    pub const VALUE: Needs = Needs {
+        grad_v: false,
+        grad_w: false,
+        mixed: false,
+        hessian: false,
+    };
+
+    /// `J`, `∇_v J`, `∇_w J` and `∇_w ∇_v J`: everything an SEPG iteration uses.
+    ///
+    /// ```
+    /// let n = sepg_mdp::oracle::Needs::SEPG;
+    /// assert!(n.grad_v && n.grad_w && n.mixed && !n.hessian);
+    /// ```
+    pub const SEPG: Needs = Needs {
+        grad_v: true,
+        grad_w: true,
+        mixed: true,
+        hessian: false,
+    };
+
+    /// Everything, as [`ExactOracle::evaluate`] returns.
+    ///
+    /// ```
+    /// assert!(sepg_mdp::oracle::Needs::ALL.hessian);
+    /// ```
+    pub const ALL: Needs = Needs {
+        grad_v: true,
+        grad_w: true,
+        mixed: true,
+        hessian: true,
+    };
+}
+
 /// An oracle computing `J` and its derivatives exactly (SPEC §5 "exact" gradient mode, the
 /// setting of thesis Sec 4.3 where `∇_v J` and `∇_w J` are known).
 ///
@@ -254,6 +317,32 @@ pub trait ExactOracle {
         exploration: &Exploration,
         horizon: Horizon,
     ) -> Result<ExactEval, OracleError>;
+
+    /// `J` and at least the derivatives `needs` asks for (an oracle may return more; the
+    /// default computes everything with [`evaluate`](Self::evaluate)). Fields of quantities
+    /// neither requested nor computed are empty (`hessian: None`).
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate).
+    ///
+    /// ```
+    /// use sepg_mdp::lqg_model::LqgModel;
+    /// use sepg_mdp::oracle::{ClosedFormOracle, ExactOracle, Exploration, Horizon, Needs};
+    /// let o = ClosedFormOracle::new(&LqgModel::thesis()).unwrap();
+    /// let ex = Exploration::Gaussian { w: vec![0.0] };
+    /// let e = o.evaluate_with(&[-0.5], &ex, Horizon::Finite(20), Needs::SEPG).unwrap();
+    /// assert_eq!(e, o.evaluate(&[-0.5], &ex, Horizon::Finite(20)).unwrap());
+    /// ```
+    fn evaluate_with(
+        &self,
+        v: &[f64],
+        exploration: &Exploration,
+        horizon: Horizon,
+        needs: Needs,
+    ) -> Result<ExactEval, OracleError> {
+        let _ = needs;
+        self.evaluate(v, exploration, horizon)
+    }
 
     /// [`evaluate`](Self::evaluate) at the parameters of a linear policy with features
     /// `φ(s) = s` (its feature dimension must be the state dimension).

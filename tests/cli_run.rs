@@ -1,0 +1,305 @@
+//! `sepg run`: the run folder and its log, resume after SIGKILL or SIGINT bit for bit,
+//! determinism across thread counts, and the bad-input contract.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use crate::common::{assert_usage_error, sepg};
+
+/// The form of the issue, which scripts depend on, with fewer iterations.
+fn issue_form(out: &Path, iterations: &str) -> Vec<String> {
+    [
+        "run", "--env", "lqg1d", "--algo", "sepg-zv", "--gradients", "sampled", "--v0", "-0.1", "--sigma0",
+        "1.0", "--iterations", iterations, "--batch", "100", "--horizon", "20", "--delta", "0.2", "--seed", "1",
+        "--quiet", "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([out.display().to_string()])
+    .collect()
+}
+
+fn run_ok(args: &[String]) {
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = sepg(&refs);
+    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&read(p)).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// v* of both LQG presets, (1 − √(1 + 4γ²)) / (2γ) with γ = 0.99 (SPEC §1).
+fn v_star() -> f64 {
+    let g: f64 = 0.99;
+    (1.0 - (1.0 + 4.0 * g * g).sqrt()) / (2.0 * g)
+}
+
+#[test]
+fn the_issue_form_writes_a_complete_run_folder() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("run");
+    run_ok(&issue_form(&dir, "30"));
+    for f in ["config.toml", "log.csv", "summary.json", "checkpoint.json"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    assert!(!dir.join("log.partial.csv").exists());
+    let log = read(&dir.join("log.csv"));
+    let mut lines = log.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    for col in [
+        "iteration", "v", "w", "sigma", "j_explore", "j_target", "budget", "required", "alpha", "beta", "infeasible",
+        "trajectories", "steps", "lambda_v", "lambda_w", "guaranteed_v", "guaranteed_w",
+    ] {
+        assert!(header.contains(&col), "column {col} missing from {header:?}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 30);
+    let at = |row: &Vec<&str>, col: &str| row[header.iter().position(|c| *c == col).expect("column")].to_string();
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row.len(), header.len());
+        assert_eq!(at(row, "iteration"), i.to_string());
+        // N = 100 trajectories per iteration, each exactly H = 20 steps (LQG never terminates).
+        assert_eq!(at(row, "trajectories"), (100 * (i + 1)).to_string());
+        assert_eq!(at(row, "steps"), (2000 * (i + 1)).to_string());
+        assert_eq!(at(row, "w_target"), "-inf", "ZV's target is deterministic");
+    }
+    assert_eq!(at(&rows[0], "v"), "-0.1");
+    assert_eq!(at(&rows[0], "sigma"), "1.0");
+    let config = read(&dir.join("config.toml"));
+    for line in ["env = \"lqg1d\"", "algo = \"sepg-zv\"", "seed = 1", "delta = 0.2", "sepg-version = "] {
+        assert!(config.contains(line), "{line} missing from config.toml:\n{config}");
+    }
+    let s = json(&dir.join("summary.json"));
+    assert_eq!(s["status"], "complete");
+    assert_eq!(s["iterations"], 30);
+    let vs = s["v_star"][0].as_f64().expect("v*");
+    assert!((vs - v_star()).abs() < 1e-12, "{vs}");
+    let v = s["final"]["v"][0].as_f64().expect("v");
+    assert_eq!(s["abs_v_error"].as_f64(), Some((v - vs).abs()));
+    let ck = json(&dir.join("checkpoint.json"));
+    assert_eq!(ck["state"]["v"][0].as_f64(), Some(v));
+    assert_eq!(ck["state"]["iteration"], 30);
+    assert!(s["iterations_per_s"].as_f64().expect("rate") > 0.0);
+}
+
+#[test]
+fn flags_override_the_config_file_and_multi_dimensional_columns_are_indexed() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let cfg = tmp.path().join("c.toml");
+    std::fs::write(&cfg, "env = \"mountain-car\"\nseed = 5\niterations = 7\nbatch = 12\nhorizon = 40\n").expect("write");
+    let dir = tmp.path().join("mc");
+    let args: Vec<String> = ["run", "--config", cfg.to_str().expect("utf-8"), "--iterations", "2", "--quiet", "--out"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([dir.display().to_string()])
+        .collect();
+    run_ok(&args);
+    let config = read(&dir.join("config.toml"));
+    assert!(config.contains("iterations = 2") && config.contains("seed = 5"), "{config}");
+    // Mountain Car: B⁰ defaults to 1 (SPEC §5) and state+bias features give 3 mean parameters.
+    assert!(config.contains("budget0 = 1.0") && config.contains("features = \"state-bias\""), "{config}");
+    let log = read(&dir.join("log.csv"));
+    let header = log.lines().next().expect("header");
+    assert!(header.starts_with("iteration,v_0,v_1,v_2,w,sigma,"), "{header}");
+    assert_eq!(log.lines().count(), 3);
+}
+
+fn partial_state(dir: &Path) -> (u64, usize) {
+    let ck = json(&dir.join("checkpoint.json"));
+    let iteration = ck["state"]["iteration"].as_u64().expect("iteration");
+    let bytes = ck["log_bytes"].as_u64().expect("log_bytes") as usize;
+    (iteration, bytes)
+}
+
+/// After a kill, the folder is consistent: no `log.csv` or `summary.json`, and the first
+/// `log_bytes` bytes of the partial log hold exactly the checkpoint's iterations.
+fn assert_consistent_after_kill(dir: &Path) {
+    assert!(!dir.join("log.csv").exists(), "a killed run must not leave a log.csv");
+    assert!(!dir.join("summary.json").exists());
+    let (iteration, bytes) = partial_state(dir);
+    let partial = std::fs::read(dir.join("log.partial.csv")).expect("partial log");
+    assert!(partial.len() >= bytes);
+    let text = String::from_utf8(partial[..bytes].to_vec()).expect("utf-8");
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len() as u64, iteration);
+    if let Some(last) = rows.last() {
+        assert_eq!(last.split(',').next(), Some((iteration - 1).to_string().as_str()));
+    }
+}
+
+fn assert_same_run(a: &Path, b: &Path) {
+    assert_eq!(std::fs::read(a.join("log.csv")).expect("log"), std::fs::read(b.join("log.csv")).expect("log"));
+    let (sa, sb) = (json(&a.join("summary.json")), json(&b.join("summary.json")));
+    assert_eq!(sa["final"], sb["final"]);
+    assert_eq!(sa["infeasible_iterations"], sb["infeasible_iterations"]);
+    assert_eq!(json(&a.join("checkpoint.json"))["state"], json(&b.join("checkpoint.json"))["state"]);
+}
+
+fn resume(dir: &Path) {
+    let out = sepg(&["run", "--resume", dir.to_str().expect("utf-8"), "--quiet"]);
+    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn resuming_after_sigkill_at_random_points_is_bit_identical() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let iterations = "1500";
+    let reference = tmp.path().join("reference");
+    let start = Instant::now();
+    run_ok(&[issue_form(&reference, iterations), vec!["--checkpoint-every".into(), "37".into()]].concat());
+    let full = start.elapsed();
+    // Kill points drawn uniformly over the reference run time (a fixed stream, so the
+    // attempts are the same on every machine up to its speed).
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let mut killed_mid_run = 0;
+    for attempt in 0..6 {
+        let dir = tmp.path().join(format!("killed-{attempt}"));
+        let args = [issue_form(&dir, iterations), vec!["--checkpoint-every".into(), "37".into()]].concat();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn");
+        std::thread::sleep(full.mul_f64(rng.random_range(0.1..0.9)));
+        child.kill().expect("SIGKILL");
+        child.wait().expect("wait");
+        if dir.join("summary.json").exists() {
+            continue;
+        }
+        if !dir.join("config.toml").exists() {
+            // Killed before the run folder was set up: nothing to resume, start again.
+            continue;
+        }
+        killed_mid_run += 1;
+        assert_consistent_after_kill(&dir);
+        resume(&dir);
+        assert_same_run(&reference, &dir);
+    }
+    assert!(killed_mid_run >= 2, "only {killed_mid_run} kills landed mid-run (reference took {full:?})");
+}
+
+#[test]
+fn sigint_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let reference = tmp.path().join("reference");
+    let start = Instant::now();
+    run_ok(&issue_form(&reference, "1500"));
+    let full = start.elapsed();
+    let dir = tmp.path().join("interrupted");
+    let child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(issue_form(&dir, "1500"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // Wait until the run folder exists, then interrupt halfway.
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while !dir.join("config.toml").exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    std::thread::sleep(full / 3);
+    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill");
+    assert!(status.success());
+    let out = child.wait_with_output().expect("wait");
+    if dir.join("summary.json").exists() {
+        // The run finished before the signal arrived; nothing was interrupted.
+        assert_same_run(&reference, &dir);
+        return;
+    }
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert_eq!(err.lines().count(), 1, "{err:?}");
+    assert!(err.contains("interrupted") && err.contains("--resume"), "{err}");
+    assert_consistent_after_kill(&dir);
+    // SIGINT stops right after an iteration and checkpoints it: the log ends exactly there.
+    let (_, bytes) = partial_state(&dir);
+    assert_eq!(std::fs::metadata(dir.join("log.partial.csv")).expect("log").len() as usize, bytes);
+    resume(&dir);
+    assert_same_run(&reference, &dir);
+}
+
+#[test]
+fn logs_are_byte_identical_with_one_and_two_threads() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let mut logs = Vec::new();
+    for threads in ["1", "2"] {
+        let dir = tmp.path().join(format!("t{threads}"));
+        // N = 300: several rollout chunks per block, so two threads really split the work.
+        let args = ["run", "--env", "lqg", "--algo", "sepg-lv", "--batch", "300", "--iterations", "40", "--quiet", "--out"];
+        let out = Command::new(env!("CARGO_BIN_EXE_sepg"))
+            .args(args)
+            .arg(&dir)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("run");
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        logs.push(std::fs::read(dir.join("log.csv")).expect("log"));
+    }
+    assert_eq!(logs[0], logs[1]);
+}
+
+#[test]
+fn resuming_a_complete_run_changes_nothing() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("done");
+    run_ok(&issue_form(&dir, "5"));
+    let before = std::fs::read(dir.join("summary.json")).expect("summary");
+    resume(&dir);
+    assert_eq!(std::fs::read(dir.join("summary.json")).expect("summary"), before);
+}
+
+/// Asserts the bad-input contract and that `out` was not created.
+fn assert_rejected(args: &[&str], out: &Path) -> String {
+    let line = assert_usage_error(&sepg(args));
+    assert!(!out.exists(), "{} was created for {args:?}", out.display());
+    line
+}
+
+#[test]
+fn bad_input_is_one_line_exit_2_and_writes_nothing() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("out");
+    let o = out.to_str().expect("utf-8");
+    assert_rejected(&["run", "--bogus", "--out", o], &out);
+    assert_rejected(&["run", "--algo", "sepg-xx", "--out", o], &out);
+    let line = assert_rejected(&["run", "--config", "/nonexistent/c.toml", "--out", o], &out);
+    assert!(line.contains("/nonexistent/c.toml"), "{line}");
+    for (name, text, needle) in [
+        ("unknown.toml", "iterations = 3\nbogus = 1\n", "bogus"),
+        ("sigma.toml", "sigma0 = 0.0\n", "sigma0"),
+        ("negative.toml", "sigma0 = -1.0\n", "sigma0"),
+        ("batch.toml", "batch = 1\n", "batch"),
+        ("inapplicable.toml", "algo = \"sepg-zv\"\nlr = 0.1\n", "lr"),
+        ("syntax.toml", "iterations = \n", "syntax.toml"),
+    ] {
+        let cfg = tmp.path().join(name);
+        std::fs::write(&cfg, text).expect("write");
+        let line = assert_rejected(&["run", "--config", cfg.to_str().expect("utf-8"), "--out", o], &out);
+        assert!(line.contains(needle), "{name}: {line}");
+    }
+    assert_rejected(&["run", "--sigma0", "0", "--out", o], &out);
+    assert_rejected(&["run", "--batch", "1", "--out", o], &out);
+    assert_rejected(&["run", "--algo", "gpomdp-const", "--out", o], &out);
+    assert_rejected(&["run", "--iterations", "5"], &out);
+    assert_rejected(&["run", "--resume", o], &out);
+    // An existing non-empty folder is left untouched without --force.
+    std::fs::create_dir(&out).expect("mkdir");
+    std::fs::write(out.join("keep.txt"), "mine").expect("write");
+    let line = assert_usage_error(&sepg(&["run", "--iterations", "2", "--out", o]));
+    assert!(line.contains("--force"), "{line}");
+    assert_eq!(std::fs::read_dir(&out).expect("dir").count(), 1);
+    let forced = sepg(&["run", "--iterations", "2", "--batch", "12", "--quiet", "--force", "--out", o]);
+    assert_eq!(forced.status.code(), Some(0));
+    assert_eq!(read(&out.join("keep.txt")), "mine");
+    assert!(out.join("summary.json").is_file());
+}
