@@ -26,19 +26,29 @@ pub struct CliError {
 impl CliError {
     /// Bad input: exit status 2.
     pub fn usage(message: impl Into<String>) -> Self {
-        CliError { code: EXIT_USAGE, message: message.into() }
+        CliError {
+            code: EXIT_USAGE,
+            message: message.into(),
+        }
     }
 
     /// A failure while running: exit status 1.
     pub fn failure(message: impl Into<String>) -> Self {
-        CliError { code: EXIT_FAILURE, message: message.into() }
+        CliError {
+            code: EXIT_FAILURE,
+            message: message.into(),
+        }
     }
 }
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // Keep the report on a single line whatever the underlying error printed.
-        let one_line = self.message.split_whitespace().collect::<Vec<_>>().join(" ");
+        let one_line = self
+            .message
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         f.write_str(&one_line)
     }
 }
@@ -65,7 +75,7 @@ enum Command {
     /// Monte Carlo J, grad_v J and grad_w J with 95% confidence intervals.
     Estimate(commands::estimate::EstimateArgs),
     /// Run SEPG or a comparison algorithm into a run folder (log, summary, checkpoint).
-    Run(commands::run::RunArgs),
+    Run(Box<commands::run::RunArgs>),
     /// Run every (preset, variant, σ⁰, seed) of a sweep file in parallel, or one shard of it.
     Sweep(commands::sweep::SweepArgs),
     /// Combine the shard folders of one sweep into a single sweep folder.
@@ -74,6 +84,8 @@ enum Command {
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Plot performance, σ, v and budget of a run or sweep folder.
     Plot(commands::plot::PlotArgs),
+    /// Re-check a run's log against its safety requirement (exact J where an oracle exists).
+    Audit(commands::audit::AuditArgs),
 }
 
 /// Parses the command line, runs the command and maps failures to exit statuses.
@@ -114,6 +126,7 @@ pub fn run() -> ExitCode {
         Command::Merge(args) => commands::merge::run(&args),
         Command::Reproduce(args) => commands::reproduce::run(&args),
         Command::Plot(args) => commands::plot::run(&args),
+        Command::Audit(args) => commands::audit::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,7 +6,16 @@ use std::f64::consts::PI;
 use crate::common::{assert_usage_error, close, json_ok, sepg};
 
 const BASE: [&str; 10] = [
-    "bounds", "--gamma", "0.99", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma",
+    "bounds",
+    "--gamma",
+    "0.99",
+    "--r-max",
+    "4",
+    "--m-phi",
+    "2",
+    "--action-volume",
+    "4",
+    "--sigma",
 ];
 
 fn run_json(extra: &[&str]) -> serde_json::Value {
@@ -18,7 +27,9 @@ fn run_json(extra: &[&str]) -> serde_json::Value {
 }
 
 fn get(v: &serde_json::Value, key: &str) -> f64 {
-    v[key].as_f64().unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
 }
 
 /// c and d of Theorems 4.2 and 4.3 written out again from the printed formulas.
@@ -45,7 +56,14 @@ fn constants_only_match_the_printed_formulas() {
 #[test]
 fn gradients_give_every_step_quantity() {
     let v = run_json(&[
-        "--grad-v", "0.8,-1.5", "--grad-w", "0.05", "--grad-w-l", "-0.3", "--required", "-1e-9",
+        "--grad-v",
+        "0.8,-1.5",
+        "--grad-w",
+        "0.05",
+        "--grad-w-l",
+        "-0.3",
+        "--required",
+        "-1e-9",
     ]);
     let (c, d) = c_and_d(0.99, 4.0, 2.0, 4.0, 0.5);
     let required = -1e-9;
@@ -54,10 +72,18 @@ fn gradients_give_every_step_quantity() {
     let lambda_v = (1.0 - required / c_max_v).sqrt();
     assert!(close(get(&v, "c_max_v"), c_max_v, 1e-12));
     assert!(close(get(&v, "lambda_v"), lambda_v, 1e-12));
-    assert!(close(get(&v, "alpha_bar"), (1.0 + lambda_v) / (2.0 * c), 1e-12));
+    assert!(close(
+        get(&v, "alpha_bar"),
+        (1.0 + lambda_v) / (2.0 * c),
+        1e-12
+    ));
     assert_eq!(v["greedy_index"].as_u64(), Some(1));
     // Corollary 4.4: L = ‖∇_v J‖₂²/(4mc) with m = 2.
-    assert!(close(get(&v, "surrogate"), (0.64 + 2.25) / (8.0 * c), 1e-12));
+    assert!(close(
+        get(&v, "surrogate"),
+        (0.64 + 2.25) / (8.0 * c),
+        1e-12
+    ));
     // Theorems 4.3 and 4.5.
     let (gj, gl) = (0.05, -0.3);
     let c_max_w = gj * gj / (4.0 * d);
@@ -66,7 +92,11 @@ fn gradients_give_every_step_quantity() {
     assert!(close(get(&v, "c_max_w"), c_max_w, 1e-12));
     assert!(close(get(&v, "lambda_w"), lambda_w, 1e-12));
     assert!(close(get(&v, "beta_tilde"), beta_tilde, 1e-12));
-    assert!(close(get(&v, "beta_bar"), beta_tilde + lambda_w * beta_tilde.abs(), 1e-12));
+    assert!(close(
+        get(&v, "beta_bar"),
+        beta_tilde + lambda_w * beta_tilde.abs(),
+        1e-12
+    ));
 }
 
 #[test]
@@ -86,20 +116,106 @@ fn plain_output_is_a_table() {
     let out = sepg(&args);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).expect("utf-8");
-    for key in ["psi", "alpha_star", "beta_star", "c_max_v", "lambda_v", "alpha_bar"] {
-        assert!(text.lines().any(|l| l.starts_with(key)), "row {key} missing in\n{text}");
+    for key in [
+        "psi",
+        "alpha_star",
+        "beta_star",
+        "c_max_v",
+        "lambda_v",
+        "alpha_bar",
+    ] {
+        assert!(
+            text.lines().any(|l| l.starts_with(key)),
+            "row {key} missing in\n{text}"
+        );
     }
 }
 
 #[test]
 fn bad_input_is_one_line_and_exit_2() {
     let cases: [&[&str]; 7] = [
-        &["bounds", "--gamma", "1.5", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma", "0.5"],
-        &["bounds", "--gamma", "0.99", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma", "-1"],
-        &["bounds", "--gamma", "0.99", "--r-max", "0", "--m-phi", "2", "--action-volume", "4", "--sigma", "1"],
-        &["bounds", "--gamma", "0.99", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma", "1", "--grad-v", "1,x"],
-        &["bounds", "--gamma", "0.99", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma", "1", "--grad-w-l", "1"],
-        &["bounds", "--gamma", "nan", "--r-max", "4", "--m-phi", "2", "--action-volume", "4", "--sigma", "1"],
+        &[
+            "bounds",
+            "--gamma",
+            "1.5",
+            "--r-max",
+            "4",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "0.5",
+        ],
+        &[
+            "bounds",
+            "--gamma",
+            "0.99",
+            "--r-max",
+            "4",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "-1",
+        ],
+        &[
+            "bounds",
+            "--gamma",
+            "0.99",
+            "--r-max",
+            "0",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "1",
+        ],
+        &[
+            "bounds",
+            "--gamma",
+            "0.99",
+            "--r-max",
+            "4",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "1",
+            "--grad-v",
+            "1,x",
+        ],
+        &[
+            "bounds",
+            "--gamma",
+            "0.99",
+            "--r-max",
+            "4",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "1",
+            "--grad-w-l",
+            "1",
+        ],
+        &[
+            "bounds",
+            "--gamma",
+            "nan",
+            "--r-max",
+            "4",
+            "--m-phi",
+            "2",
+            "--action-volume",
+            "4",
+            "--sigma",
+            "1",
+        ],
         &["bounds", "--gamma", "0.99", "--bogus"],
     ];
     for args in cases {
@@ -107,5 +223,8 @@ fn bad_input_is_one_line_and_exit_2() {
         assert!(line.starts_with("sepg: error:"), "{line}");
     }
     let line = assert_usage_error(&sepg(cases[0]));
-    assert!(line.contains("gamma"), "the message names the parameter: {line}");
+    assert!(
+        line.contains("gamma"),
+        "the message names the parameter: {line}"
+    );
 }

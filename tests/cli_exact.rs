@@ -4,7 +4,9 @@
 use crate::common::{assert_usage_error, close, json_ok, sepg};
 
 fn get(v: &serde_json::Value, key: &str) -> f64 {
-    v[key].as_f64().unwrap_or_else(|| panic!("key {key} missing in {v}"))
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing in {v}"))
 }
 
 /// Unclipped scalar LQG, infinite horizon, policy a ~ N(v s, σ²), s' = s + a, reward
@@ -23,10 +25,15 @@ fn optimal_values_of_both_presets() {
     assert!(close(v_star, -0.615_251_245_663_011, 1e-14));
     let vs = v_star.to_string();
     for (preset, expected) in [("lqg", -1.076_834), ("lqg1d", -7.753_206)] {
-        let out = json_ok(&sepg(&["exact", "--env", preset, "--v", &vs, "--sigma", "0", "--json"]));
+        let out = json_ok(&sepg(&[
+            "exact", "--env", preset, "--v", &vs, "--sigma", "0", "--json",
+        ]));
         assert!((get(&out, "j") - expected).abs() < 5e-7, "{preset}: {out}");
         assert!(get(&out, "grad_v").abs() < 1e-9, "v* is stationary: {out}");
-        assert!(out.get("grad_w").is_none(), "no w-gradient for the deterministic policy");
+        assert!(
+            out.get("grad_w").is_none(),
+            "no w-gradient for the deterministic policy"
+        );
     }
 }
 
@@ -50,24 +57,52 @@ fn stochastic_closed_form_matches_value_and_finite_differences() {
 #[test]
 fn clipped_model_by_dynamic_programming() {
     let clipped = json_ok(&sepg(&[
-        "exact", "--env", "lqg", "--v", "-0.5", "--sigma", "0.3", "--clipped", "--horizon", "20",
+        "exact",
+        "--env",
+        "lqg",
+        "--v",
+        "-0.5",
+        "--sigma",
+        "0.3",
+        "--clipped",
+        "--horizon",
+        "20",
         "--json",
     ]));
     assert_eq!(clipped["oracle"], "clipped-dp");
     // Clipping can only lose return relative to nothing: the clipped J is finite and below 0,
     // and with a = −0.5 s the closed loop contracts, so it stays close to the unclipped value.
     let unclipped = json_ok(&sepg(&[
-        "exact", "--env", "lqg", "--v", "-0.5", "--sigma", "0.3", "--horizon", "20", "--json",
+        "exact",
+        "--env",
+        "lqg",
+        "--v",
+        "-0.5",
+        "--sigma",
+        "0.3",
+        "--horizon",
+        "20",
+        "--json",
     ]));
     let (jc, ju) = (get(&clipped, "j"), get(&unclipped, "j"));
-    assert!(jc < 0.0 && (jc - ju).abs() < 0.05 * ju.abs(), "{jc} vs {ju}");
+    assert!(
+        jc < 0.0 && (jc - ju).abs() < 0.05 * ju.abs(),
+        "{jc} vs {ju}"
+    );
     assert!(get(&clipped, "mixed_wv").is_finite());
 }
 
 #[test]
 fn replay_follows_the_gym_rules() {
     let out = json_ok(&sepg(&[
-        "replay", "--env", "mountain-car", "--state", "0.44,0.02", "--actions", "0.5,1,1", "--json",
+        "replay",
+        "--env",
+        "mountain-car",
+        "--state",
+        "0.44,0.02",
+        "--actions",
+        "0.5,1,1",
+        "--json",
     ]));
     // One step by hand: vel' = vel + 0.0015·clip(a) − 0.0025·cos(3·pos); pos' = pos + vel'.
     let vel = 0.02 + 0.0015 * 0.5 - 0.0025 * (3.0f64 * 0.44).cos();
@@ -77,15 +112,30 @@ fn replay_follows_the_gym_rules() {
     assert_eq!(out["positions"][1].as_f64(), Some(pos));
     assert_eq!(out["velocities"][1].as_f64(), Some(vel));
     assert_eq!(out["rewards"].as_array().map(Vec::len), Some(1));
-    assert!(close(out["rewards"][0].as_f64().unwrap_or(f64::NAN), 100.0 - 0.1 * 0.25, 1e-15));
+    assert!(close(
+        out["rewards"][0].as_f64().unwrap_or(f64::NAN),
+        100.0 - 0.1 * 0.25,
+        1e-15
+    ));
 
     // The left wall stops the car, and the reward uses the raw action.
     let out = json_ok(&sepg(&[
-        "replay", "--env", "mountain-car", "--state", "-1.2,-0.01", "--actions", "-3", "--json",
+        "replay",
+        "--env",
+        "mountain-car",
+        "--state",
+        "-1.2,-0.01",
+        "--actions",
+        "-3",
+        "--json",
     ]));
     assert_eq!(out["positions"][1].as_f64(), Some(-1.2));
     assert_eq!(out["velocities"][1].as_f64(), Some(0.0));
-    assert!(close(out["rewards"][0].as_f64().unwrap_or(f64::NAN), -0.9, 1e-15));
+    assert!(close(
+        out["rewards"][0].as_f64().unwrap_or(f64::NAN),
+        -0.9,
+        1e-15
+    ));
     assert!(out["terminated_at"].is_null());
 }
 
@@ -94,13 +144,58 @@ fn bad_input_is_one_line_and_exit_2() {
     let cases: [&[&str]; 9] = [
         &["exact", "--env", "pendulum", "--v", "-0.5", "--sigma", "1"],
         &["exact", "--env", "lqg", "--v", "-0.5", "--sigma", "-1"],
-        &["exact", "--env", "lqg", "--v", "-0.5", "--sigma", "1", "--horizon", "0"],
-        &["exact", "--env", "lqg", "--v", "-0.5", "--sigma", "1", "--clipped", "--horizon", "inf"],
+        &[
+            "exact",
+            "--env",
+            "lqg",
+            "--v",
+            "-0.5",
+            "--sigma",
+            "1",
+            "--horizon",
+            "0",
+        ],
+        &[
+            "exact",
+            "--env",
+            "lqg",
+            "--v",
+            "-0.5",
+            "--sigma",
+            "1",
+            "--clipped",
+            "--horizon",
+            "inf",
+        ],
         &["exact", "--env", "lqg", "--v", "0.5", "--sigma", "1"],
         &["replay", "--env", "lqg", "--state", "0,0", "--actions", "1"],
-        &["replay", "--env", "mountain-car", "--state", "0", "--actions", "1"],
-        &["replay", "--env", "mountain-car", "--state", "-0.5,0", "--actions", "1,,x"],
-        &["replay", "--env", "mountain-car", "--state", "3,0", "--actions", "1"],
+        &[
+            "replay",
+            "--env",
+            "mountain-car",
+            "--state",
+            "0",
+            "--actions",
+            "1",
+        ],
+        &[
+            "replay",
+            "--env",
+            "mountain-car",
+            "--state",
+            "-0.5,0",
+            "--actions",
+            "1,,x",
+        ],
+        &[
+            "replay",
+            "--env",
+            "mountain-car",
+            "--state",
+            "3,0",
+            "--actions",
+            "1",
+        ],
     ];
     for args in cases {
         let line = assert_usage_error(&sepg(args));
@@ -115,12 +210,33 @@ fn bad_input_is_one_line_and_exit_2() {
 #[test]
 fn estimate_agrees_with_the_exact_clipped_oracle() {
     let exact = json_ok(&sepg(&[
-        "exact", "--env", "lqg", "--v", "-0.4", "--sigma", "0.6", "--clipped", "--horizon", "20",
+        "exact",
+        "--env",
+        "lqg",
+        "--v",
+        "-0.4",
+        "--sigma",
+        "0.6",
+        "--clipped",
+        "--horizon",
+        "20",
         "--json",
     ]));
     let est = json_ok(&sepg(&[
-        "estimate", "--env", "lqg", "--v", "-0.4", "--sigma", "0.6", "--horizon", "20", "--n",
-        "20000", "--seed", "7", "--json",
+        "estimate",
+        "--env",
+        "lqg",
+        "--v",
+        "-0.4",
+        "--sigma",
+        "0.6",
+        "--horizon",
+        "20",
+        "--n",
+        "20000",
+        "--seed",
+        "7",
+        "--json",
     ]));
     for (key, exact_key) in [("j", "j"), ("grad_v", "grad_v"), ("grad_w", "grad_w")] {
         let mean = est[key]["mean"].as_f64().expect("mean");
@@ -128,7 +244,10 @@ fn estimate_agrees_with_the_exact_clipped_oracle() {
         let hi = est[key]["ci95"][1].as_f64().expect("ci high");
         let se = (hi - lo) / 2.0 / 1.959_963_984_540_054;
         let truth = get(&exact, exact_key);
-        assert!((mean - truth).abs() <= 4.5 * se, "{key}: {mean} ± {se} vs exact {truth}");
+        assert!(
+            (mean - truth).abs() <= 4.5 * se,
+            "{key}: {mean} ± {se} vs exact {truth}"
+        );
     }
     assert!(get(&est, "steps_per_sec") > 0.0);
     assert_eq!(est["steps"].as_u64(), Some(400_000));
@@ -137,8 +256,20 @@ fn estimate_agrees_with_the_exact_clipped_oracle() {
 #[test]
 fn estimate_is_reproducible_and_rejects_bad_input() {
     let args = [
-        "estimate", "--env", "mountain-car", "--v", "0,0.5,0", "--sigma", "1", "--horizon", "50",
-        "--n", "10", "--seed", "3", "--json",
+        "estimate",
+        "--env",
+        "mountain-car",
+        "--v",
+        "0,0.5,0",
+        "--sigma",
+        "1",
+        "--horizon",
+        "50",
+        "--n",
+        "10",
+        "--seed",
+        "3",
+        "--json",
     ];
     let (a, b) = (json_ok(&sepg(&args)), json_ok(&sepg(&args)));
     assert_eq!(a["j"], b["j"]);
@@ -146,12 +277,96 @@ fn estimate_is_reproducible_and_rejects_bad_input() {
     assert_eq!(a["grad_v"]["mean"].as_array().map(Vec::len), Some(3));
 
     let cases: [&[&str]; 6] = [
-        &["estimate", "--env", "cartpole", "--v", "0", "--sigma", "1", "--horizon", "5", "--n", "4", "--seed", "1"],
-        &["estimate", "--env", "lqg", "--v", "0", "--sigma", "-1", "--horizon", "5", "--n", "4", "--seed", "1"],
-        &["estimate", "--env", "lqg", "--v", "0", "--sigma", "1", "--horizon", "0", "--n", "4", "--seed", "1"],
-        &["estimate", "--env", "lqg", "--v", "0", "--sigma", "1", "--horizon", "5", "--n", "1", "--seed", "1"],
-        &["estimate", "--env", "lqg", "--v", "0,1", "--sigma", "1", "--horizon", "5", "--n", "4", "--seed", "1"],
-        &["estimate", "--env", "lqg", "--v", "zero", "--sigma", "1", "--horizon", "5", "--n", "4", "--seed", "1"],
+        &[
+            "estimate",
+            "--env",
+            "cartpole",
+            "--v",
+            "0",
+            "--sigma",
+            "1",
+            "--horizon",
+            "5",
+            "--n",
+            "4",
+            "--seed",
+            "1",
+        ],
+        &[
+            "estimate",
+            "--env",
+            "lqg",
+            "--v",
+            "0",
+            "--sigma",
+            "-1",
+            "--horizon",
+            "5",
+            "--n",
+            "4",
+            "--seed",
+            "1",
+        ],
+        &[
+            "estimate",
+            "--env",
+            "lqg",
+            "--v",
+            "0",
+            "--sigma",
+            "1",
+            "--horizon",
+            "0",
+            "--n",
+            "4",
+            "--seed",
+            "1",
+        ],
+        &[
+            "estimate",
+            "--env",
+            "lqg",
+            "--v",
+            "0",
+            "--sigma",
+            "1",
+            "--horizon",
+            "5",
+            "--n",
+            "1",
+            "--seed",
+            "1",
+        ],
+        &[
+            "estimate",
+            "--env",
+            "lqg",
+            "--v",
+            "0,1",
+            "--sigma",
+            "1",
+            "--horizon",
+            "5",
+            "--n",
+            "4",
+            "--seed",
+            "1",
+        ],
+        &[
+            "estimate",
+            "--env",
+            "lqg",
+            "--v",
+            "zero",
+            "--sigma",
+            "1",
+            "--horizon",
+            "5",
+            "--n",
+            "4",
+            "--seed",
+            "1",
+        ],
     ];
     for args in cases {
         let line = assert_usage_error(&sepg(args));

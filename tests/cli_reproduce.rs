@@ -7,7 +7,12 @@ use crate::common::{assert_usage_error, sepg};
 
 fn ok(args: &[&str]) -> String {
     let out = sepg(args);
-    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).expect("utf-8")
 }
 
@@ -20,12 +25,30 @@ fn table_5_1_is_the_t_bound_of_the_runs_next_to_the_thesis() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("t");
     let d = dir.to_str().expect("utf-8");
-    let stdout = ok(&["reproduce", "table-5.1", "--preset", "lqg1d", "--seeds", "2", "--iterations", "15", "--quiet", "--out", d]);
+    let stdout = ok(&[
+        "reproduce",
+        "table-5.1",
+        "--preset",
+        "lqg1d",
+        "--seeds",
+        "2",
+        "--iterations",
+        "15",
+        "--quiet",
+        "--out",
+        d,
+    ]);
     assert!(stdout.contains("| σ⁰ | adam-1e-4 |"), "{stdout}");
-    assert_eq!(std::fs::read_to_string(dir.join("table-5.1.md")).expect("md"), stdout);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("table-5.1.md")).expect("md"),
+        stdout
+    );
     let csv = std::fs::read_to_string(dir.join("table-5.1.csv")).expect("csv");
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("preset,sigma0,variant,seeds,iterations,mean,sd,ucb95,thesis"));
+    assert_eq!(
+        lines.next(),
+        Some("preset,sigma0,variant,seeds,iterations,mean,sd,ucb95,thesis")
+    );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 4 * 11);
     let sweep = json(&dir.join("sweep.json"));
@@ -38,7 +61,10 @@ fn table_5_1_is_the_t_bound_of_the_runs_next_to_the_thesis() {
             .iter()
             .filter(|r| r["variant"] == variant && r["sigma0"].as_f64() == Some(sigma0))
             .map(|r| {
-                let s = json(&dir.join(r["dir"].as_str().expect("dir")).join("summary.json"));
+                let s = json(
+                    &dir.join(r["dir"].as_str().expect("dir"))
+                        .join("summary.json"),
+                );
                 let v = s["final"]["v"][0].as_f64().expect("v");
                 (v - s["v_star"][0].as_f64().expect("v*")).abs()
             })
@@ -48,11 +74,17 @@ fn table_5_1_is_the_t_bound_of_the_runs_next_to_the_thesis() {
         let sd = (errors[0] - errors[1]).abs() / 2f64.sqrt();
         let ucb = mean + t * sd / 2f64.sqrt();
         let got = row[7].parse::<f64>().expect("ucb");
-        assert!((got - ucb).abs() <= 1e-12 * ucb.abs().max(1.0), "{row:?}: {got} vs {ucb}");
+        assert!(
+            (got - ucb).abs() <= 1e-12 * ucb.abs().max(1.0),
+            "{row:?}: {got} vs {ucb}"
+        );
     }
     // The published values, copied from the thesis's Table 5.1.
     let published = |sigma0: &str, variant: &str| {
-        rows.iter().find(|r| r[1] == sigma0 && r[2] == variant).map(|r| r[8].to_owned()).expect("row")
+        rows.iter()
+            .find(|r| r[1] == sigma0 && r[2] == variant)
+            .map(|r| r[8].to_owned())
+            .expect("row")
     };
     assert_eq!(published("0.1", "adam-1e-4"), "0.126");
     assert_eq!(published("0.5", "lb1"), "0.29");
@@ -65,8 +97,22 @@ fn figures_and_plots_are_png_and_svg() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("f");
     let d = dir.to_str().expect("utf-8");
-    let stdout = ok(&["reproduce", "fig-5.1", "--preset", "lqg", "--seeds", "2", "--iterations", "10", "--out", d]);
-    assert!(stdout.contains("fig-5.1-lqg.png") && stdout.contains("fig-5.1-lqg.svg"), "{stdout}");
+    let stdout = ok(&[
+        "reproduce",
+        "fig-5.1",
+        "--preset",
+        "lqg",
+        "--seeds",
+        "2",
+        "--iterations",
+        "10",
+        "--out",
+        d,
+    ]);
+    assert!(
+        stdout.contains("fig-5.1-lqg.png") && stdout.contains("fig-5.1-lqg.svg"),
+        "{stdout}"
+    );
     let png = std::fs::read(dir.join("fig-5.1-lqg.png")).expect("png");
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let svg = std::fs::read_to_string(dir.join("fig-5.1-lqg.svg")).expect("svg");
@@ -76,8 +122,17 @@ fn figures_and_plots_are_png_and_svg() {
     assert!(dir.join("plot.png").is_file() && dir.join("plot.svg").is_file());
     let run = dir.join("runs/lqg/mi/sigma-1.0/seed-0");
     let file = tmp.path().join("one.svg");
-    ok(&["plot", run.to_str().expect("utf-8"), "--out", file.to_str().expect("utf-8")]);
-    assert!(std::fs::read_to_string(&file).expect("svg").contains("budget"));
+    ok(&[
+        "plot",
+        run.to_str().expect("utf-8"),
+        "--out",
+        file.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        std::fs::read_to_string(&file)
+            .expect("svg")
+            .contains("budget")
+    );
 }
 
 #[test]
@@ -86,9 +141,23 @@ fn bad_reproduce_and_plot_input_is_rejected() {
     let out = tmp.path().join("x");
     let o = out.to_str().expect("utf-8");
     assert_usage_error(&sepg(&["reproduce", "table-9.9", "--out", o]));
-    assert_usage_error(&sepg(&["reproduce", "fig-5.4", "--preset", "lqg", "--out", o]));
+    assert_usage_error(&sepg(&[
+        "reproduce",
+        "fig-5.4",
+        "--preset",
+        "lqg",
+        "--out",
+        o,
+    ]));
     assert_usage_error(&sepg(&["reproduce", "fig-5.1", "--seeds", "0", "--out", o]));
-    assert_usage_error(&sepg(&["reproduce", "fig-5.1", "--delta", "1.5", "--out", o]));
+    assert_usage_error(&sepg(&[
+        "reproduce",
+        "fig-5.1",
+        "--delta",
+        "1.5",
+        "--out",
+        o,
+    ]));
     assert!(!out.exists());
     assert_usage_error(&sepg(&["plot", tmp.path().to_str().expect("utf-8")]));
     assert_usage_error(&sepg(&["plot", o, "--out", "figure.pdf"]));

@@ -13,9 +13,29 @@ use crate::common::{assert_usage_error, sepg};
 /// The form of the issue, which scripts depend on, with fewer iterations.
 fn issue_form(out: &Path, iterations: &str) -> Vec<String> {
     [
-        "run", "--env", "lqg1d", "--algo", "sepg-zv", "--gradients", "sampled", "--v0", "-0.1", "--sigma0",
-        "1.0", "--iterations", iterations, "--batch", "100", "--horizon", "20", "--delta", "0.2", "--seed", "1",
-        "--quiet", "--out",
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-zv",
+        "--gradients",
+        "sampled",
+        "--v0",
+        "-0.1",
+        "--sigma0",
+        "1.0",
+        "--iterations",
+        iterations,
+        "--batch",
+        "100",
+        "--horizon",
+        "20",
+        "--delta",
+        "0.2",
+        "--seed",
+        "1",
+        "--quiet",
+        "--out",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -26,7 +46,12 @@ fn issue_form(out: &Path, iterations: &str) -> Vec<String> {
 fn run_ok(args: &[String]) {
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     let out = sepg(&refs);
-    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 fn read(p: &Path) -> String {
@@ -56,14 +81,34 @@ fn the_issue_form_writes_a_complete_run_folder() {
     let mut lines = log.lines();
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     for col in [
-        "iteration", "v", "w", "sigma", "j_explore", "j_target", "budget", "required", "alpha", "beta", "infeasible",
-        "trajectories", "steps", "lambda_v", "lambda_w", "guaranteed_v", "guaranteed_w",
+        "iteration",
+        "v",
+        "w",
+        "sigma",
+        "j_explore",
+        "j_target",
+        "budget",
+        "required",
+        "alpha",
+        "beta",
+        "infeasible",
+        "trajectories",
+        "steps",
+        "lambda_v",
+        "lambda_w",
+        "guaranteed_v",
+        "guaranteed_w",
     ] {
-        assert!(header.contains(&col), "column {col} missing from {header:?}");
+        assert!(
+            header.contains(&col),
+            "column {col} missing from {header:?}"
+        );
     }
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 30);
-    let at = |row: &Vec<&str>, col: &str| row[header.iter().position(|c| *c == col).expect("column")].to_string();
+    let at = |row: &Vec<&str>, col: &str| {
+        row[header.iter().position(|c| *c == col).expect("column")].to_string()
+    };
     for (i, row) in rows.iter().enumerate() {
         assert_eq!(row.len(), header.len());
         assert_eq!(at(row, "iteration"), i.to_string());
@@ -75,8 +120,17 @@ fn the_issue_form_writes_a_complete_run_folder() {
     assert_eq!(at(&rows[0], "v"), "-0.1");
     assert_eq!(at(&rows[0], "sigma"), "1.0");
     let config = read(&dir.join("config.toml"));
-    for line in ["env = \"lqg1d\"", "algo = \"sepg-zv\"", "seed = 1", "delta = 0.2", "sepg-version = "] {
-        assert!(config.contains(line), "{line} missing from config.toml:\n{config}");
+    for line in [
+        "env = \"lqg1d\"",
+        "algo = \"sepg-zv\"",
+        "seed = 1",
+        "delta = 0.2",
+        "sepg-version = ",
+    ] {
+        assert!(
+            config.contains(line),
+            "{line} missing from config.toml:\n{config}"
+        );
     }
     let s = json(&dir.join("summary.json"));
     assert_eq!(s["status"], "complete");
@@ -95,21 +149,42 @@ fn the_issue_form_writes_a_complete_run_folder() {
 fn flags_override_the_config_file_and_multi_dimensional_columns_are_indexed() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let cfg = tmp.path().join("c.toml");
-    std::fs::write(&cfg, "env = \"mountain-car\"\nseed = 5\niterations = 7\nbatch = 12\nhorizon = 40\n").expect("write");
+    std::fs::write(
+        &cfg,
+        "env = \"mountain-car\"\nseed = 5\niterations = 7\nbatch = 12\nhorizon = 40\n",
+    )
+    .expect("write");
     let dir = tmp.path().join("mc");
-    let args: Vec<String> = ["run", "--config", cfg.to_str().expect("utf-8"), "--iterations", "2", "--quiet", "--out"]
-        .iter()
-        .map(|s| s.to_string())
-        .chain([dir.display().to_string()])
-        .collect();
+    let args: Vec<String> = [
+        "run",
+        "--config",
+        cfg.to_str().expect("utf-8"),
+        "--iterations",
+        "2",
+        "--quiet",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([dir.display().to_string()])
+    .collect();
     run_ok(&args);
     let config = read(&dir.join("config.toml"));
-    assert!(config.contains("iterations = 2") && config.contains("seed = 5"), "{config}");
+    assert!(
+        config.contains("iterations = 2") && config.contains("seed = 5"),
+        "{config}"
+    );
     // Mountain Car: B⁰ defaults to 1 (SPEC §5) and state+bias features give 3 mean parameters.
-    assert!(config.contains("budget0 = 1.0") && config.contains("features = \"state-bias\""), "{config}");
+    assert!(
+        config.contains("budget0 = 1.0") && config.contains("features = \"state-bias\""),
+        "{config}"
+    );
     let log = read(&dir.join("log.csv"));
     let header = log.lines().next().expect("header");
-    assert!(header.starts_with("iteration,v_0,v_1,v_2,w,sigma,"), "{header}");
+    assert!(
+        header.starts_with("iteration,v_0,v_1,v_2,w,sigma,"),
+        "{header}"
+    );
     assert_eq!(log.lines().count(), 3);
 }
 
@@ -123,7 +198,10 @@ fn partial_state(dir: &Path) -> (u64, usize) {
 /// After a kill, the folder is consistent: no `log.csv` or `summary.json`, and the first
 /// `log_bytes` bytes of the partial log hold exactly the checkpoint's iterations.
 fn assert_consistent_after_kill(dir: &Path) {
-    assert!(!dir.join("log.csv").exists(), "a killed run must not leave a log.csv");
+    assert!(
+        !dir.join("log.csv").exists(),
+        "a killed run must not leave a log.csv"
+    );
     assert!(!dir.join("summary.json").exists());
     let (iteration, bytes) = partial_state(dir);
     let partial = std::fs::read(dir.join("log.partial.csv")).expect("partial log");
@@ -132,21 +210,35 @@ fn assert_consistent_after_kill(dir: &Path) {
     let rows: Vec<&str> = text.lines().skip(1).collect();
     assert_eq!(rows.len() as u64, iteration);
     if let Some(last) = rows.last() {
-        assert_eq!(last.split(',').next(), Some((iteration - 1).to_string().as_str()));
+        assert_eq!(
+            last.split(',').next(),
+            Some((iteration - 1).to_string().as_str())
+        );
     }
 }
 
 fn assert_same_run(a: &Path, b: &Path) {
-    assert_eq!(std::fs::read(a.join("log.csv")).expect("log"), std::fs::read(b.join("log.csv")).expect("log"));
+    assert_eq!(
+        std::fs::read(a.join("log.csv")).expect("log"),
+        std::fs::read(b.join("log.csv")).expect("log")
+    );
     let (sa, sb) = (json(&a.join("summary.json")), json(&b.join("summary.json")));
     assert_eq!(sa["final"], sb["final"]);
     assert_eq!(sa["infeasible_iterations"], sb["infeasible_iterations"]);
-    assert_eq!(json(&a.join("checkpoint.json"))["state"], json(&b.join("checkpoint.json"))["state"]);
+    assert_eq!(
+        json(&a.join("checkpoint.json"))["state"],
+        json(&b.join("checkpoint.json"))["state"]
+    );
 }
 
 fn resume(dir: &Path) {
     let out = sepg(&["run", "--resume", dir.to_str().expect("utf-8"), "--quiet"]);
-    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -155,7 +247,13 @@ fn resuming_after_sigkill_at_random_points_is_bit_identical() {
     let iterations = "1500";
     let reference = tmp.path().join("reference");
     let start = Instant::now();
-    run_ok(&[issue_form(&reference, iterations), vec!["--checkpoint-every".into(), "37".into()]].concat());
+    run_ok(
+        &[
+            issue_form(&reference, iterations),
+            vec!["--checkpoint-every".into(), "37".into()],
+        ]
+        .concat(),
+    );
     let full = start.elapsed();
     // Kill points drawn uniformly over the reference run time (a fixed stream, so the
     // attempts are the same on every machine up to its speed).
@@ -163,7 +261,11 @@ fn resuming_after_sigkill_at_random_points_is_bit_identical() {
     let mut killed_mid_run = 0;
     for attempt in 0..6 {
         let dir = tmp.path().join(format!("killed-{attempt}"));
-        let args = [issue_form(&dir, iterations), vec!["--checkpoint-every".into(), "37".into()]].concat();
+        let args = [
+            issue_form(&dir, iterations),
+            vec!["--checkpoint-every".into(), "37".into()],
+        ]
+        .concat();
         let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
             .args(&args)
             .stdout(Stdio::null())
@@ -185,7 +287,10 @@ fn resuming_after_sigkill_at_random_points_is_bit_identical() {
         resume(&dir);
         assert_same_run(&reference, &dir);
     }
-    assert!(killed_mid_run >= 2, "only {killed_mid_run} kills landed mid-run (reference took {full:?})");
+    assert!(
+        killed_mid_run >= 2,
+        "only {killed_mid_run} kills landed mid-run (reference took {full:?})"
+    );
 }
 
 #[test]
@@ -208,7 +313,10 @@ fn sigint_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
         std::thread::sleep(Duration::from_millis(1));
     }
     std::thread::sleep(full / 3);
-    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill");
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
     assert!(status.success());
     let out = child.wait_with_output().expect("wait");
     if dir.join("summary.json").exists() {
@@ -219,11 +327,19 @@ fn sigint_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert_eq!(err.lines().count(), 1, "{err:?}");
-    assert!(err.contains("interrupted") && err.contains("--resume"), "{err}");
+    assert!(
+        err.contains("interrupted") && err.contains("--resume"),
+        "{err}"
+    );
     assert_consistent_after_kill(&dir);
     // SIGINT stops right after an iteration and checkpoints it: the log ends exactly there.
     let (_, bytes) = partial_state(&dir);
-    assert_eq!(std::fs::metadata(dir.join("log.partial.csv")).expect("log").len() as usize, bytes);
+    assert_eq!(
+        std::fs::metadata(dir.join("log.partial.csv"))
+            .expect("log")
+            .len() as usize,
+        bytes
+    );
     resume(&dir);
     assert_same_run(&reference, &dir);
 }
@@ -235,14 +351,31 @@ fn logs_are_byte_identical_with_one_and_two_threads() {
     for threads in ["1", "2"] {
         let dir = tmp.path().join(format!("t{threads}"));
         // N = 300: several rollout chunks per block, so two threads really split the work.
-        let args = ["run", "--env", "lqg", "--algo", "sepg-lv", "--batch", "300", "--iterations", "40", "--quiet", "--out"];
+        let args = [
+            "run",
+            "--env",
+            "lqg",
+            "--algo",
+            "sepg-lv",
+            "--batch",
+            "300",
+            "--iterations",
+            "40",
+            "--quiet",
+            "--out",
+        ];
         let out = Command::new(env!("CARGO_BIN_EXE_sepg"))
             .args(args)
             .arg(&dir)
             .env("RAYON_NUM_THREADS", threads)
             .output()
             .expect("run");
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         logs.push(std::fs::read(dir.join("log.csv")).expect("log"));
     }
     assert_eq!(logs[0], logs[1]);
@@ -255,7 +388,10 @@ fn resuming_a_complete_run_changes_nothing() {
     run_ok(&issue_form(&dir, "5"));
     let before = std::fs::read(dir.join("summary.json")).expect("summary");
     resume(&dir);
-    assert_eq!(std::fs::read(dir.join("summary.json")).expect("summary"), before);
+    assert_eq!(
+        std::fs::read(dir.join("summary.json")).expect("summary"),
+        before
+    );
 }
 
 /// Asserts the bad-input contract and that `out` was not created.
@@ -272,7 +408,10 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     let o = out.to_str().expect("utf-8");
     assert_rejected(&["run", "--bogus", "--out", o], &out);
     assert_rejected(&["run", "--algo", "sepg-xx", "--out", o], &out);
-    let line = assert_rejected(&["run", "--config", "/nonexistent/c.toml", "--out", o], &out);
+    let line = assert_rejected(
+        &["run", "--config", "/nonexistent/c.toml", "--out", o],
+        &out,
+    );
     assert!(line.contains("/nonexistent/c.toml"), "{line}");
     for (name, text, needle) in [
         ("unknown.toml", "iterations = 3\nbogus = 1\n", "bogus"),
@@ -284,7 +423,10 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     ] {
         let cfg = tmp.path().join(name);
         std::fs::write(&cfg, text).expect("write");
-        let line = assert_rejected(&["run", "--config", cfg.to_str().expect("utf-8"), "--out", o], &out);
+        let line = assert_rejected(
+            &["run", "--config", cfg.to_str().expect("utf-8"), "--out", o],
+            &out,
+        );
         assert!(line.contains(needle), "{name}: {line}");
     }
     assert_rejected(&["run", "--sigma0", "0", "--out", o], &out);
@@ -298,7 +440,17 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     let line = assert_usage_error(&sepg(&["run", "--iterations", "2", "--out", o]));
     assert!(line.contains("--force"), "{line}");
     assert_eq!(std::fs::read_dir(&out).expect("dir").count(), 1);
-    let forced = sepg(&["run", "--iterations", "2", "--batch", "12", "--quiet", "--force", "--out", o]);
+    let forced = sepg(&[
+        "run",
+        "--iterations",
+        "2",
+        "--batch",
+        "12",
+        "--quiet",
+        "--force",
+        "--out",
+        o,
+    ]);
     assert_eq!(forced.status.code(), Some(0));
     assert_eq!(read(&out.join("keep.txt")), "mine");
     assert!(out.join("summary.json").is_file());

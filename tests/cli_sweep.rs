@@ -38,7 +38,12 @@ fn sweep_into(cfg: &Path, out: &Path, extra: &[&str], threads: &str) {
         .env("RAYON_NUM_THREADS", threads)
         .output()
         .expect("sweep");
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 fn json(p: &Path) -> serde_json::Value {
@@ -70,9 +75,15 @@ fn merged_shards_equal_the_unsharded_sweep_whatever_the_thread_count() {
     let reference = logs(&one);
     // 2 presets × 2 variants × 2 σ⁰ × 2 seeds, each log with a header and 12 rows.
     assert_eq!(reference.len(), 16);
-    assert!(reference.iter().all(|(_, l)| l.iter().filter(|&&b| b == b'\n').count() == 13));
+    assert!(
+        reference
+            .iter()
+            .all(|(_, l)| l.iter().filter(|&&b| b == b'\n').count() == 13)
+    );
     assert_eq!(logs(&two), reference, "logs differ between 1 and 2 threads");
-    let shards: Vec<PathBuf> = (0..3).map(|i| tmp.path().join(format!("shard-{i}"))).collect();
+    let shards: Vec<PathBuf> = (0..3)
+        .map(|i| tmp.path().join(format!("shard-{i}")))
+        .collect();
     for (i, s) in shards.iter().enumerate() {
         sweep_into(&cfg, s, &["--shard", &format!("{i}/3")], "2");
         let file = json(&s.join("sweep.json"));
@@ -80,17 +91,33 @@ fn merged_shards_equal_the_unsharded_sweep_whatever_the_thread_count() {
         // A shard holds exactly the runs whose index mod 3 is its index.
         for r in file["runs"].as_array().expect("runs") {
             let index = r["index"].as_u64().expect("index") as usize;
-            assert_eq!(s.join(r["dir"].as_str().expect("dir")).exists(), index % 3 == i);
+            assert_eq!(
+                s.join(r["dir"].as_str().expect("dir")).exists(),
+                index % 3 == i
+            );
         }
     }
     let merged = tmp.path().join("merged");
-    let mut args = vec!["merge".to_owned(), "--quiet".into(), "--out".into(), merged.display().to_string()];
+    let mut args = vec![
+        "merge".to_owned(),
+        "--quiet".into(),
+        "--out".into(),
+        merged.display().to_string(),
+    ];
     args.extend(shards.iter().rev().map(|s| s.display().to_string()));
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     let out = sepg(&refs);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(logs(&merged), reference);
-    let (m, u) = (json(&merged.join("sweep.json")), json(&one.join("sweep.json")));
+    let (m, u) = (
+        json(&merged.join("sweep.json")),
+        json(&one.join("sweep.json")),
+    );
     assert_eq!(m["sweep_id"], u["sweep_id"]);
     assert_eq!(m["runs"], u["runs"]);
     assert_eq!(m["shard"], u["shard"]);
@@ -98,18 +125,34 @@ fn merged_shards_equal_the_unsharded_sweep_whatever_the_thread_count() {
 
     // Merging an incomplete set of shards, or one shard twice, is refused.
     let out_bad = tmp.path().join("bad");
-    let (s0, s1) = (shards[0].to_str().expect("utf-8"), shards[1].to_str().expect("utf-8"));
+    let (s0, s1) = (
+        shards[0].to_str().expect("utf-8"),
+        shards[1].to_str().expect("utf-8"),
+    );
     let o = out_bad.to_str().expect("utf-8");
     let line = assert_usage_error(&sepg(&["merge", "--out", o, s0, s1]));
-    assert!(line.contains("missing shard") && line.contains("2/3"), "{line}");
+    assert!(
+        line.contains("missing shard") && line.contains("2/3"),
+        "{line}"
+    );
     assert_usage_error(&sepg(&["merge", "--out", o, s0, s0, s1]));
     // A shard of another sweep is refused.
     let other_cfg = tmp.path().join("other");
     std::fs::create_dir(&other_cfg).expect("mkdir");
-    let other_cfg = sweep_file(&other_cfg, &SWEEP.replace("seeds = [3, 4]", "seeds = [3, 5]"));
+    let other_cfg = sweep_file(
+        &other_cfg,
+        &SWEEP.replace("seeds = [3, 4]", "seeds = [3, 5]"),
+    );
     let other = tmp.path().join("other-shard");
     sweep_into(&other_cfg, &other, &["--shard", "2/3"], "2");
-    let line = assert_usage_error(&sepg(&["merge", "--out", o, s0, s1, other.to_str().expect("utf-8")]));
+    let line = assert_usage_error(&sepg(&[
+        "merge",
+        "--out",
+        o,
+        s0,
+        s1,
+        other.to_str().expect("utf-8"),
+    ]));
     assert!(line.contains("same sweep"), "{line}");
     assert!(!out_bad.exists());
 }
@@ -120,26 +163,56 @@ fn bad_sweeps_are_rejected_before_anything_is_written() {
     let out = tmp.path().join("out");
     let o = out.to_str().expect("utf-8");
     let cases = [
-        ("axis", SWEEP.replace("lr = 1e-3", "lr = 1e-3\nseed = 3"), "sweep axes"),
-        ("unknown", SWEEP.replace("[base]", "bogus = 1\n[base]"), "bogus"),
-        ("duplicate", SWEEP.replace("name = \"adam\"", "name = \"zv\""), "twice"),
-        ("sigma", SWEEP.replace("sigma0 = [0.5, 1.0]", "sigma0 = [0.5, -1.0]"), "sigma0"),
+        (
+            "axis",
+            SWEEP.replace("lr = 1e-3", "lr = 1e-3\nseed = 3"),
+            "sweep axes",
+        ),
+        (
+            "unknown",
+            SWEEP.replace("[base]", "bogus = 1\n[base]"),
+            "bogus",
+        ),
+        (
+            "duplicate",
+            SWEEP.replace("name = \"adam\"", "name = \"zv\""),
+            "twice",
+        ),
+        (
+            "sigma",
+            SWEEP.replace("sigma0 = [0.5, 1.0]", "sigma0 = [0.5, -1.0]"),
+            "sigma0",
+        ),
         ("batch", SWEEP.replace("batch = 24", "batch = 1"), "batch"),
     ];
     for (name, text, needle) in cases {
         let dir = tmp.path().join(name);
         std::fs::create_dir(&dir).expect("mkdir");
         let cfg = sweep_file(&dir, &text);
-        let line = assert_usage_error(&sepg(&["sweep", "--config", cfg.to_str().expect("utf-8"), "--out", o]));
+        let line = assert_usage_error(&sepg(&[
+            "sweep",
+            "--config",
+            cfg.to_str().expect("utf-8"),
+            "--out",
+            o,
+        ]));
         assert!(line.contains(needle), "{name}: {line}");
         assert!(!out.exists(), "{name}");
     }
     let cfg = sweep_file(tmp.path(), SWEEP);
     let c = cfg.to_str().expect("utf-8");
     for shard in ["3/3", "1", "a/2", "0/0"] {
-        assert_usage_error(&sepg(&["sweep", "--config", c, "--out", o, "--shard", shard]));
+        assert_usage_error(&sepg(&[
+            "sweep", "--config", c, "--out", o, "--shard", shard,
+        ]));
     }
-    assert_usage_error(&sepg(&["sweep", "--config", "/nonexistent.toml", "--out", o]));
+    assert_usage_error(&sepg(&[
+        "sweep",
+        "--config",
+        "/nonexistent.toml",
+        "--out",
+        o,
+    ]));
     assert!(!out.exists());
 }
 
@@ -152,7 +225,10 @@ fn an_interrupted_sweep_resumes_to_the_same_logs() {
     let dir = tmp.path().join("resumed");
     sweep_into(&cfg, &dir, &[], "2");
     // Simulate runs killed at different points: one never started, one mid-run.
-    let runs = json(&dir.join("sweep.json"))["runs"].as_array().expect("runs").clone();
+    let runs = json(&dir.join("sweep.json"))["runs"]
+        .as_array()
+        .expect("runs")
+        .clone();
     let gone = dir.join(runs[0]["dir"].as_str().expect("dir"));
     std::fs::remove_dir_all(&gone).expect("remove");
     let cut = dir.join(runs[5]["dir"].as_str().expect("dir"));
@@ -163,6 +239,11 @@ fn an_interrupted_sweep_resumes_to_the_same_logs() {
     partial.extend_from_slice(b"12,torn row");
     std::fs::write(cut.join("log.partial.csv"), partial).expect("write");
     let out = sepg(&["sweep", "--quiet", "--resume", dir.to_str().expect("utf-8")]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(logs(&dir), logs(&reference));
 }

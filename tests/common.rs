@@ -13,8 +13,17 @@ pub fn sepg(args: &[&str]) -> Output {
 /// Asserts the contract for bad input: exit status 2, nothing on standard output, exactly
 /// one non-empty line on standard error. Returns that line.
 pub fn assert_usage_error(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(2), "stderr: {}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.stdout.is_empty(), "stdout must be empty, got {:?}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "stdout must be empty, got {:?}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     let err = String::from_utf8(out.stderr.clone()).expect("utf-8 stderr");
     let lines: Vec<&str> = err.lines().collect();
     assert_eq!(lines.len(), 1, "exactly one line on stderr, got {err:?}");
@@ -24,7 +33,12 @@ pub fn assert_usage_error(out: &Output) -> String {
 
 /// Parses standard output as one JSON object, asserting success.
 pub fn json_ok(out: &Output) -> serde_json::Value {
-    assert_eq!(out.status.code(), Some(0), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("stdout is one JSON value")
 }
 

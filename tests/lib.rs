@@ -1,5 +1,6 @@
 //! Integration tests of the `sepg` command-line interface, compiled into one binary.
 
+mod cli_audit;
 mod cli_bounds;
 mod cli_exact;
 mod cli_reproduce;

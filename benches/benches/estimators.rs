@@ -1,10 +1,14 @@
 //! Cost of the estimators on a batch of N = 100 trajectories of H = 20 steps (m = 1 and m = 4
 //! mean parameters), next to the cost of generating such a batch with the rollout engine.
+//!
+//! `w_block` is what one SEPG w-block computes from its batch: `Ĵ`, `∇̂_w J` and `∇̂_w L`.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, SurrogateEstimate, Width};
+use sepg_estimators::{
+    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Param, SurrogateEstimate, Width,
+};
 use sepg_mdp::Batch;
 use sepg_mdp::env::LqgEnv;
 use sepg_mdp::policy::GaussianPolicy;
@@ -87,6 +91,26 @@ fn bench_estimators(c: &mut Criterion) {
                 est.surrogate_gradient(black_box(&batch), spec, 2.0, &[-1.0], &mut sur)
                     .expect("estimate");
                 black_box(sur.grad_w_l().mean()[0]);
+            })
+        });
+        c.bench_function(&format!("estimators/{label}/h_opt_loo"), |bch| {
+            bch.iter(|| {
+                let (baseline, fit) = (Baseline::Optimal, BaselineFit::LeaveOneOut);
+                est.h(black_box(&batch), baseline, fit, &mut out)
+                    .expect("estimate");
+                black_box(out.mean()[0]);
+            })
+        });
+        let mut value = Estimate::new();
+        c.bench_function(&format!("estimators/{label}/w_block"), |bch| {
+            bch.iter(|| {
+                let batch = black_box(&batch);
+                est.value(batch, &mut value).expect("estimate");
+                est.gradient(batch, Param::W, spec, &mut out)
+                    .expect("estimate");
+                est.surrogate_gradient(batch, spec, 2.0, &[-1.0], &mut sur)
+                    .expect("estimate");
+                black_box((value.mean()[0], out.mean()[0], sur.grad_w_l().mean()[0]));
             })
         });
     }

@@ -2,10 +2,10 @@
 //! determine (Theorems 3.11, 3.13, 3.14, 4.2, 4.3, 4.5, Lemma A.1, Corollary 4.4).
 
 use clap::Args;
-use serde::Serialize;
 use sepg_bounds::constants::{self, TaskConstants};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
+use serde::Serialize;
 
 use crate::cli::CliError;
 use crate::output::to_json_line;
@@ -139,7 +139,10 @@ fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
         Some(nu) => sepg_bounds::budget::split_requirement(a.required, nu).map_err(bad)?,
         None => {
             if !a.required.is_finite() {
-                return Err(CliError::usage(format!("required must be finite, got {}", a.required)));
+                return Err(CliError::usage(format!(
+                    "required must be finite, got {}",
+                    a.required
+                )));
             }
             (a.required, a.required)
         }
@@ -212,7 +215,11 @@ fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
             r.batch_gpomdp = Some(batch_size::gpomdp(&k, sigma, delta, eps, h).map_err(bad)?);
         }
         (None, None, None) => {}
-        _ => return Err(CliError::usage("batch sizes need all of --delta, --eps and --horizon")),
+        _ => {
+            return Err(CliError::usage(
+                "batch sizes need all of --delta, --eps and --horizon",
+            ));
+        }
     }
     Ok(r)
 }
@@ -224,16 +231,32 @@ fn fmt_opt(x: Option<f64>) -> String {
 fn render_table(r: &BoundsReport) -> String {
     let mut rows: Vec<(&str, String, &str)> = vec![
         ("psi", format!("{:.10}", r.psi), "Lemma A.1"),
-        ("c", format!("{:.6e}", r.c), "Thm 4.2 (Papini et al. Thm 3.14)"),
+        (
+            "c",
+            format!("{:.6e}", r.c),
+            "Thm 4.2 (Papini et al. Thm 3.14)",
+        ),
         ("d", format!("{:.6e}", r.d), "Thm 4.3"),
         ("dc_dsigma", format!("{:.6e}", r.dc_dsigma), "Appendix B"),
-        ("alpha_star", format!("{:.6e}", r.alpha_star), "Thm 4.2: 1/(2c)"),
-        ("beta_star", format!("{:.6e}", r.beta_star), "Thm 4.3: 1/(2d)"),
+        (
+            "alpha_star",
+            format!("{:.6e}", r.alpha_star),
+            "Thm 4.2: 1/(2c)",
+        ),
+        (
+            "beta_star",
+            format!("{:.6e}", r.beta_star),
+            "Thm 4.3: 1/(2d)",
+        ),
         ("required_v", format!("{:.6e}", r.required_v), "(4.13)"),
         ("required_w", format!("{:.6e}", r.required_w), "(4.14)"),
     ];
     let opt_rows: [(&str, Option<f64>, &str); 13] = [
-        ("surrogate_coefficient", r.surrogate_coefficient, "Cor 4.4: 1/(4mc)"),
+        (
+            "surrogate_coefficient",
+            r.surrogate_coefficient,
+            "Cor 4.4: 1/(4mc)",
+        ),
         ("c_max_v", r.c_max_v, "(4.9)"),
         ("lambda_v", r.lambda_v, "(4.10)"),
         ("alpha_bar", r.alpha_bar, "(4.20): (1+lambda_v) alpha_star"),
@@ -242,10 +265,22 @@ fn render_table(r: &BoundsReport) -> String {
         ("pirotta_guarantee", r.pirotta_guarantee, "Cor 3.11"),
         ("c_max_w", r.c_max_w, "(4.16)"),
         ("lambda_w", r.lambda_w, "(4.17)"),
-        ("beta_bar_j", r.beta_bar_j, "(4.17): largest step along grad_w J"),
+        (
+            "beta_bar_j",
+            r.beta_bar_j,
+            "(4.17): largest step along grad_w J",
+        ),
         ("beta_tilde", r.beta_tilde, "Thm 4.5"),
-        ("beta_bar", r.beta_bar, "(4.20): beta_tilde + lambda_w |beta_tilde|"),
-        ("batch_gpomdp", r.batch_gpomdp.map(|n| n as f64), "Cor 3.13 (G(PO)MDP)"),
+        (
+            "beta_bar",
+            r.beta_bar,
+            "(4.20): beta_tilde + lambda_w |beta_tilde|",
+        ),
+        (
+            "batch_gpomdp",
+            r.batch_gpomdp.map(|n| n as f64),
+            "Cor 3.13 (G(PO)MDP)",
+        ),
     ];
     for (name, value, cite) in opt_rows {
         if value.is_some() {
@@ -253,10 +288,18 @@ fn render_table(r: &BoundsReport) -> String {
         }
     }
     if let Some(n) = r.batch_reinforce {
-        rows.push(("batch_reinforce", n.to_string(), "Cor 3.13 (REINFORCE, corrected)"));
+        rows.push((
+            "batch_reinforce",
+            n.to_string(),
+            "Cor 3.13 (REINFORCE, corrected)",
+        ));
     }
     if let Some(i) = r.greedy_index {
-        rows.push(("greedy_index", i.to_string(), "Thm 3.14: coordinate updated"));
+        rows.push((
+            "greedy_index",
+            i.to_string(),
+            "Thm 3.14: coordinate updated",
+        ));
     }
     for (name, feasible) in [("feasible_v", r.feasible_v), ("feasible_w", r.feasible_w)] {
         if let Some(f) = feasible {
@@ -273,7 +316,11 @@ fn render_table(r: &BoundsReport) -> String {
 /// Runs `sepg bounds`.
 pub fn run(args: &BoundsArgs) -> Result<(), CliError> {
     let report = compute(args)?;
-    let text = if args.json { to_json_line(&report)? } else { render_table(&report) };
+    let text = if args.json {
+        to_json_line(&report)?
+    } else {
+        render_table(&report)
+    };
     print!("{text}");
     Ok(())
 }

@@ -4,12 +4,12 @@
 use std::time::Instant;
 
 use clap::Args;
-use serde::Serialize;
 use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, Width};
 use sepg_mdp::env::{Environment, Preset};
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::rollout;
+use serde::Serialize;
 
 use crate::cli::CliError;
 use crate::output::to_json_line;
@@ -67,11 +67,22 @@ fn interval(e: &Estimate) -> Result<Interval, CliError> {
     let mut half = vec![0.0; e.dim()];
     e.widths_into(Width::StudentT, 0.05, &mut half)
         .map_err(|err| CliError::failure(err.to_string()))?;
-    let ci: Vec<[f64; 2]> = e.mean().iter().zip(&half).map(|(m, h)| [m - h, m + h]).collect();
+    let ci: Vec<[f64; 2]> = e
+        .mean()
+        .iter()
+        .zip(&half)
+        .map(|(m, h)| [m - h, m + h])
+        .collect();
     Ok(if e.dim() == 1 {
-        Interval::Scalar { mean: e.mean()[0], ci95: ci[0] }
+        Interval::Scalar {
+            mean: e.mean()[0],
+            ci95: ci[0],
+        }
     } else {
-        Interval::Vector { mean: e.mean().to_vec(), ci95: ci }
+        Interval::Vector {
+            mean: e.mean().to_vec(),
+            ci95: ci,
+        }
     })
 }
 
@@ -79,13 +90,19 @@ fn estimate(args: &EstimateArgs) -> Result<EstimateReport, CliError> {
     let preset = Preset::from_name(&args.env).map_err(|e| CliError::usage(e.to_string()))?;
     let env = preset.build();
     if args.n < 2 {
-        return Err(CliError::usage(format!("--n must be at least 2, got {}", args.n)));
+        return Err(CliError::usage(format!(
+            "--n must be at least 2, got {}",
+            args.n
+        )));
     }
     if args.horizon == 0 {
         return Err(CliError::usage("--horizon must be at least 1"));
     }
     if !(args.sigma.is_finite() && args.sigma >= 0.0) {
-        return Err(CliError::usage(format!("sigma must be finite and >= 0, got {}", args.sigma)));
+        return Err(CliError::usage(format!(
+            "sigma must be finite and >= 0, got {}",
+            args.sigma
+        )));
     }
     let p = env.feature_dim();
     let policy = if args.sigma == 0.0 {
@@ -111,9 +128,13 @@ fn estimate(args: &EstimateArgs) -> Result<EstimateReport, CliError> {
         (None, None)
     } else {
         let spec = GradientSpec::default();
-        estimator.gradient(&batch, Param::V, spec, &mut est).map_err(fail)?;
+        estimator
+            .gradient(&batch, Param::V, spec, &mut est)
+            .map_err(fail)?;
         let gv = interval(&est)?;
-        estimator.gradient(&batch, Param::W, spec, &mut est).map_err(fail)?;
+        estimator
+            .gradient(&batch, Param::W, spec, &mut est)
+            .map_err(fail)?;
         (Some(gv), Some(interval(&est)?))
     };
     Ok(EstimateReport {
@@ -132,7 +153,10 @@ fn estimate(args: &EstimateArgs) -> Result<EstimateReport, CliError> {
 fn render(name: &str, i: &Interval) -> String {
     match i {
         Interval::Scalar { mean, ci95 } => {
-            format!("{name:<8} {mean:>16.8e}   95% CI [{:.8e}, {:.8e}]\n", ci95[0], ci95[1])
+            format!(
+                "{name:<8} {mean:>16.8e}   95% CI [{:.8e}, {:.8e}]\n",
+                ci95[0], ci95[1]
+            )
         }
         Interval::Vector { mean, ci95 } => mean
             .iter()
@@ -140,7 +164,10 @@ fn render(name: &str, i: &Interval) -> String {
             .enumerate()
             .map(|(k, (m, c))| {
                 let label = format!("{name}[{k}]");
-                format!("{label:<8} {m:>16.8e}   95% CI [{:.8e}, {:.8e}]\n", c[0], c[1])
+                format!(
+                    "{label:<8} {m:>16.8e}   95% CI [{:.8e}, {:.8e}]\n",
+                    c[0], c[1]
+                )
             })
             .collect(),
     }

@@ -3,11 +3,11 @@
 
 use clap::Args;
 use nalgebra::DVector;
-use serde::Serialize;
 use sepg_mdp::LqgModel;
 use sepg_mdp::oracle::{
     ClippedDpOracle, ClosedFormOracle, ExactEval, ExactOracle, Exploration, Horizon, OracleError,
 };
+use serde::Serialize;
 
 use crate::cli::CliError;
 use crate::commands::parse::{HorizonArg, LqgPreset};
@@ -76,10 +76,16 @@ fn evaluate(args: &ExactArgs) -> Result<(ExactEval, Horizon), CliError> {
         return Err(CliError::usage(format!("v must be finite, got {}", args.v)));
     }
     if !(args.sigma.is_finite() && args.sigma >= 0.0) {
-        return Err(CliError::usage(format!("sigma must be finite and >= 0, got {}", args.sigma)));
+        return Err(CliError::usage(format!(
+            "sigma must be finite and >= 0, got {}",
+            args.sigma
+        )));
     }
     if !(args.eta.is_finite() && args.eta >= 0.0) {
-        return Err(CliError::usage(format!("eta must be finite and >= 0, got {}", args.eta)));
+        return Err(CliError::usage(format!(
+            "eta must be finite and >= 0, got {}",
+            args.eta
+        )));
     }
     let model: LqgModel = args
         .env
@@ -89,7 +95,9 @@ fn evaluate(args: &ExactArgs) -> Result<(ExactEval, Horizon), CliError> {
     let exploration = if args.sigma == 0.0 {
         Exploration::Deterministic
     } else {
-        Exploration::Gaussian { w: vec![args.sigma.ln()] }
+        Exploration::Gaussian {
+            w: vec![args.sigma.ln()],
+        }
     };
     let horizon = match (args.horizon, args.clipped) {
         (Some(h), _) => h.0,
@@ -98,7 +106,9 @@ fn evaluate(args: &ExactArgs) -> Result<(ExactEval, Horizon), CliError> {
     };
     let eval = if args.clipped {
         if horizon == Horizon::Infinite {
-            return Err(CliError::usage("the clipped model needs a finite --horizon"));
+            return Err(CliError::usage(
+                "the clipped model needs a finite --horizon",
+            ));
         }
         ClippedDpOracle::new(&model)
             .map_err(oracle_error)?
@@ -117,7 +127,11 @@ pub fn run(args: &ExactArgs) -> Result<(), CliError> {
     let (eval, horizon) = evaluate(args)?;
     let report = ExactReport {
         env: args.env.name(),
-        oracle: if args.clipped { "clipped-dp" } else { "closed-form" },
+        oracle: if args.clipped {
+            "clipped-dp"
+        } else {
+            "closed-form"
+        },
         horizon: match horizon {
             Horizon::Finite(h) => h.to_string(),
             Horizon::Infinite => "inf".to_string(),
@@ -131,13 +145,18 @@ pub fn run(args: &ExactArgs) -> Result<(), CliError> {
         grad_sigma: eval.grad_sigma().first().copied(),
         mixed_wv: eval.mixed_wv.first().copied(),
         hessian: eval.hessian.as_ref().map(|h| {
-            (0..h.nrows()).map(|i| (0..h.ncols()).map(|j| h[(i, j)]).collect()).collect()
+            (0..h.nrows())
+                .map(|i| (0..h.ncols()).map(|j| h[(i, j)]).collect())
+                .collect()
         }),
     };
     if args.json {
         print!("{}", to_json_line(&report)?);
     } else {
-        println!("env       {} ({} oracle, horizon {})", report.env, report.oracle, report.horizon);
+        println!(
+            "env       {} ({} oracle, horizon {})",
+            report.env, report.oracle, report.horizon
+        );
         println!("J         {:.12e}", report.j);
         println!("grad_v    {:.12e}", report.grad_v);
         if let (Some(gw), Some(gs)) = (report.grad_w, report.grad_sigma) {

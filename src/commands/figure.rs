@@ -1,6 +1,7 @@
 //! Figures as PNG and SVG (plotters) with confidence bands across seeds, rendered with an
 //! embedded font so that no system font is needed, and statistics across seeds.
 
+use std::cmp::Ordering;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -30,6 +31,9 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
+/// Lower and upper ends of a confidence band, point by point.
+pub type Band = (Vec<f64>, Vec<f64>);
+
 /// One curve: a mean over seeds and, with two seeds or more, its 95% confidence band.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
@@ -40,7 +44,7 @@ pub struct Series {
     /// Mean over seeds.
     pub mean: Vec<f64>,
     /// Lower and upper ends of the band.
-    pub band: Option<(Vec<f64>, Vec<f64>)>,
+    pub band: Option<Band>,
 }
 
 /// One panel of a figure.
@@ -75,7 +79,7 @@ pub struct Figure {
 /// ```text
 /// m = mean(y),  s = sample sd(y),  band = m ± t(0.975, K − 1) · s / √K     (K ≥ 2 seeds)
 /// ```
-pub fn mean_band(curves: &[Vec<f64>]) -> (Vec<f64>, Option<(Vec<f64>, Vec<f64>)>) {
+pub fn mean_band(curves: &[Vec<f64>]) -> (Vec<f64>, Option<Band>) {
     let len = curves.iter().map(Vec::len).min().unwrap_or(0);
     let k = curves.len();
     let mut mean = Vec::with_capacity(len);
@@ -110,12 +114,22 @@ pub fn mean_halfwidth(ys: &[f64]) -> (f64, Option<f64>) {
 
 fn register_font() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
-    let ok = *DONE.get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
-    if ok { Ok(()) } else { Err(CliError::failure("the embedded font cannot be loaded")) }
+    let ok = *DONE
+        .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    if ok {
+        Ok(())
+    } else {
+        Err(CliError::failure("the embedded font cannot be loaded"))
+    }
 }
 
 fn range(panel: &Panel) -> (f64, f64, f64, f64) {
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for s in &panel.series {
         let bands = s.band.iter().flat_map(|(lo, hi)| lo.iter().chain(hi));
         for (&x, &y) in s.x.iter().zip(&s.mean) {
@@ -137,11 +151,19 @@ fn range(panel: &Panel) -> (f64, f64, f64, f64) {
             y1 = y1.max(y);
         }
     }
-    if !(x0 < x1) {
-        (x0, x1) = if x0.is_finite() { (x0 - 1.0, x0 + 1.0) } else { (0.0, 1.0) };
+    if x0.partial_cmp(&x1) != Some(Ordering::Less) {
+        (x0, x1) = if x0.is_finite() {
+            (x0 - 1.0, x0 + 1.0)
+        } else {
+            (0.0, 1.0)
+        };
     }
-    if !(y0 < y1) {
-        (y0, y1) = if y0.is_finite() { (y0 - 0.5 * y0.abs().max(1e-9), y0 + 0.5 * y0.abs().max(1e-9)) } else { (0.0, 1.0) };
+    if y0.partial_cmp(&y1) != Some(Ordering::Less) {
+        (y0, y1) = if y0.is_finite() {
+            (y0 - 0.5 * y0.abs().max(1e-9), y0 + 0.5 * y0.abs().max(1e-9))
+        } else {
+            (0.0, 1.0)
+        };
     }
     let pad = 0.05 * (y1 - y0);
     (x0, x1, y0 - pad, y1 + pad)
@@ -149,7 +171,14 @@ fn range(panel: &Panel) -> (f64, f64, f64, f64) {
 
 fn tick(v: &f64) -> String {
     let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) { format!("{v:.1e}") } else { format!("{v:.4}").trim_end_matches('0').trim_end_matches('.').to_owned() }
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.1e}")
+    } else {
+        format!("{v:.4}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_owned()
+    }
 }
 
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
@@ -183,35 +212,53 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
         for (i, s) in panel.series.iter().enumerate() {
             let color = PALETTE[i % PALETTE.len()];
             if let Some((lo, hi)) = &s.band {
-                let mut poly: Vec<(f64, f64)> = s
-                    .x
-                    .iter()
-                    .zip(hi)
+                let mut poly: Vec<(f64, f64)> =
+                    s.x.iter()
+                        .zip(hi)
+                        .filter(|(x, y)| x.is_finite() && y.is_finite())
+                        .map(|(&x, &y)| (x, y))
+                        .collect();
+                poly.extend(
+                    s.x.iter()
+                        .zip(lo)
+                        .rev()
+                        .filter(|(x, y)| x.is_finite() && y.is_finite())
+                        .map(|(&x, &y)| (x, y)),
+                );
+                chart
+                    .draw_series(std::iter::once(Polygon::new(
+                        poly,
+                        color.mix(0.18).filled(),
+                    )))
+                    .map_err(e)?;
+            }
+            let pts: Vec<(f64, f64)> =
+                s.x.iter()
+                    .zip(&s.mean)
                     .filter(|(x, y)| x.is_finite() && y.is_finite())
                     .map(|(&x, &y)| (x, y))
                     .collect();
-                poly.extend(s.x.iter().zip(lo).rev().filter(|(x, y)| x.is_finite() && y.is_finite()).map(|(&x, &y)| (x, y)));
-                chart.draw_series(std::iter::once(Polygon::new(poly, color.mix(0.18).filled()))).map_err(e)?;
-            }
-            let pts: Vec<(f64, f64)> = s
-                .x
-                .iter()
-                .zip(&s.mean)
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .map(|(&x, &y)| (x, y))
-                .collect();
             chart
                 .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                 .map_err(e)?
                 .label(s.label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                });
         }
         for (label, y) in &panel.hlines {
             chart
-                .draw_series(DashedLineSeries::new(vec![(x0, *y), (x1, *y)], 6, 4, BLACK.stroke_width(1)))
+                .draw_series(DashedLineSeries::new(
+                    vec![(x0, *y), (x1, *y)],
+                    6,
+                    4,
+                    BLACK.stroke_width(1),
+                ))
                 .map_err(e)?
                 .label(label.as_str())
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1))
+                });
         }
         if !panel.series.is_empty() || !panel.hlines.is_empty() {
             chart
@@ -259,16 +306,22 @@ pub fn save(fig: &Figure, path: &Path) -> Result<(), CliError> {
                 .prefix(".sepg-figure-")
                 .suffix(".png")
                 .tempfile_in(&dir)
-                .map_err(|e| CliError::failure(format!("cannot write in {}: {e}", dir.display())))?;
+                .map_err(|e| {
+                    CliError::failure(format!("cannot write in {}: {e}", dir.display()))
+                })?;
             {
                 let root = BitMapBackend::new(tmp.path(), size(fig)).into_drawing_area();
                 draw(&root, fig).map_err(fail)?;
             }
-            tmp.persist(path)
-                .map_err(|e| CliError::failure(format!("cannot write {}: {}", path.display(), e.error)))?;
+            tmp.persist(path).map_err(|e| {
+                CliError::failure(format!("cannot write {}: {}", path.display(), e.error))
+            })?;
             Ok(())
         }
-        _ => Err(CliError::usage(format!("{}: figures are written as .png or .svg", path.display()))),
+        _ => Err(CliError::usage(format!(
+            "{}: figures are written as .png or .svg",
+            path.display()
+        ))),
     }
 }
 
@@ -290,11 +343,13 @@ mod tests {
 
     #[test]
     fn band_is_the_t_interval() {
-        // Values 1, 2, 3: mean 2, s = 1, t(0.975, 2) = 4.302652729911275 (tabulated).
+        // Values 1, 2, 3: mean 2, s = 1. For 2 degrees of freedom the t quantile has the
+        // closed form t(p, 2) = (2p − 1)/√(2p(1 − p)).
         let (m, h) = mean_halfwidth(&[1.0, 2.0, 3.0]);
         assert_eq!(m, 2.0);
         let h = h.expect("two or more values");
-        assert!((h - 4.302_652_729_911_275 / 3f64.sqrt()).abs() < 1e-12, "{h}");
+        let t = 0.95 / (2.0 * 0.975 * 0.025f64).sqrt();
+        assert!((h - t / 3f64.sqrt()).abs() < 1e-12, "{h}");
         assert_eq!(mean_halfwidth(&[5.0]), (5.0, None));
     }
 }

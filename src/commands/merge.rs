@@ -30,7 +30,9 @@ pub struct MergeArgs {
 }
 
 fn copy_dir(from: &Path, to: &Path) -> Result<(), CliError> {
-    let fail = |p: &Path, e: std::io::Error| CliError::failure(format!("cannot copy {}: {e}", p.display()));
+    let fail = |p: &Path, e: std::io::Error| {
+        CliError::failure(format!("cannot copy {}: {e}", p.display()))
+    };
     fs::create_dir_all(to).map_err(|e| fail(to, e))?;
     for entry in fs::read_dir(from).map_err(|e| fail(from, e))? {
         let entry = entry.map_err(|e| fail(from, e))?;
@@ -73,9 +75,15 @@ pub fn check_shards(shards: &[(PathBuf, SweepFile)]) -> Result<SweepFile, CliErr
             )));
         }
         if std::mem::replace(&mut seen[f.shard.index], true) {
-            return Err(CliError::usage(format!("shard {}/{count} is given twice", f.shard.index)));
+            return Err(CliError::usage(format!(
+                "shard {}/{count} is given twice",
+                f.shard.index
+            )));
         }
-        if let Some(r) = f.shard_runs().find(|r| !runfmt::is_complete(&dir.join(&r.dir))) {
+        if let Some(r) = f
+            .shard_runs()
+            .find(|r| !runfmt::is_complete(&dir.join(&r.dir)))
+        {
             return Err(CliError::usage(format!(
                 "run {} in {} is not complete (resume that shard first)",
                 r.dir,
@@ -83,11 +91,21 @@ pub fn check_shards(shards: &[(PathBuf, SweepFile)]) -> Result<SweepFile, CliErr
             )));
         }
     }
-    let missing: Vec<String> = (0..count).filter(|&i| !seen[i]).map(|i| format!("{i}/{count}")).collect();
+    let missing: Vec<String> = (0..count)
+        .filter(|&i| !seen[i])
+        .map(|i| format!("{i}/{count}"))
+        .collect();
     if !missing.is_empty() {
-        return Err(CliError::usage(format!("missing shard(s) {}", missing.join(", "))));
+        return Err(CliError::usage(format!(
+            "missing shard(s) {}",
+            missing.join(", ")
+        )));
     }
-    Ok(SweepFile { shard: Shard { index: 0, count: 1 }, merged_from: shards.len(), ..first.clone() })
+    Ok(SweepFile {
+        shard: Shard { index: 0, count: 1 },
+        merged_from: shards.len(),
+        ..first.clone()
+    })
 }
 
 /// Runs `sepg merge`.
@@ -115,7 +133,8 @@ pub fn run(args: &MergeArgs) -> Result<(), CliError> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    fs::create_dir_all(&parent).map_err(|e| CliError::failure(format!("cannot create {}: {e}", parent.display())))?;
+    fs::create_dir_all(&parent)
+        .map_err(|e| CliError::failure(format!("cannot create {}: {e}", parent.display())))?;
     let tmp = tempfile::Builder::new()
         .prefix(".sepg-merge-")
         .tempdir_in(&parent)
@@ -125,13 +144,18 @@ pub fn run(args: &MergeArgs) -> Result<(), CliError> {
             copy_dir(&dir.join(&r.dir), &tmp.path().join(&r.dir))?;
         }
     }
-    write_atomic(&tmp.path().join(SWEEP_FILE), to_json_line(&merged)?.as_bytes())?;
+    write_atomic(
+        &tmp.path().join(SWEEP_FILE),
+        to_json_line(&merged)?.as_bytes(),
+    )?;
     if args.out.exists() {
-        fs::remove_dir_all(&args.out)
-            .map_err(|e| CliError::failure(format!("cannot replace {}: {e}", args.out.display())))?;
+        fs::remove_dir_all(&args.out).map_err(|e| {
+            CliError::failure(format!("cannot replace {}: {e}", args.out.display()))
+        })?;
     }
     let built = tmp.keep();
-    fs::rename(&built, &args.out).map_err(|e| CliError::failure(format!("cannot create {}: {e}", args.out.display())))?;
+    fs::rename(&built, &args.out)
+        .map_err(|e| CliError::failure(format!("cannot create {}: {e}", args.out.display())))?;
     if !args.quiet {
         println!(
             "{}: {} runs from {} shards of sweep {}",

@@ -1,5 +1,6 @@
 //! One module per `sepg` subcommand.
 
+pub mod audit;
 pub mod bounds;
 pub mod estimate;
 pub mod exact;

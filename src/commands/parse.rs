@@ -39,7 +39,9 @@ impl FromStr for LqgPreset {
         match s {
             "lqg" => Ok(LqgPreset::Lqg),
             "lqg1d" => Ok(LqgPreset::Lqg1d),
-            other => Err(format!("unknown LQG preset '{other}' (expected lqg or lqg1d)")),
+            other => Err(format!(
+                "unknown LQG preset '{other}' (expected lqg or lqg1d)"
+            )),
         }
     }
 }
@@ -58,7 +60,9 @@ impl FromStr for HorizonArg {
         match s.parse::<usize>() {
             Ok(0) => Err("the horizon must be at least 1".to_string()),
             Ok(h) => Ok(HorizonArg(Horizon::Finite(h))),
-            Err(_) => Err(format!("invalid horizon '{s}' (expected a positive integer or inf)")),
+            Err(_) => Err(format!(
+                "invalid horizon '{s}' (expected a positive integer or inf)"
+            )),
         }
     }
 }

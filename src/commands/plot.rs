@@ -26,7 +26,11 @@ pub struct PlotArgs {
 
 /// The (column, panel title, axis label) of the four panels.
 const PANELS: [(&str, &str, &str); 4] = [
-    ("j_explore", "performance J(θᵗ) of the exploratory policy", "J"),
+    (
+        "j_explore",
+        "performance J(θᵗ) of the exploratory policy",
+        "J",
+    ),
     ("sigma", "standard deviation σᵗ", "σ"),
     ("v", "mean parameter vᵗ (first component)", "v"),
     ("budget", "budget Bᵗ", "B"),
@@ -34,26 +38,54 @@ const PANELS: [(&str, &str, &str); 4] = [
 
 fn one_run(dir: &Path) -> Result<Figure, CliError> {
     let log = Log::read_run(dir)?;
-    let x = log.column("iteration").ok_or_else(|| CliError::usage(format!("{}: log has no iteration column", dir.display())))?;
-    let name = runfmt::RunSpec::from_file(&dir.join(runfmt::CONFIG_FILE))?.name.unwrap_or_default();
+    let x = log.column("iteration").ok_or_else(|| {
+        CliError::usage(format!("{}: log has no iteration column", dir.display()))
+    })?;
+    let name = runfmt::RunSpec::from_file(&dir.join(runfmt::CONFIG_FILE))?
+        .name
+        .unwrap_or_default();
     let panels = PANELS
         .iter()
         .map(|&(col, title, y)| {
             let mut series: Vec<Series> = log
                 .column(col)
-                .map(|mean| Series { label: name.clone(), x: x.clone(), mean, band: None })
+                .map(|mean| Series {
+                    label: name.clone(),
+                    x: x.clone(),
+                    mean,
+                    band: None,
+                })
                 .into_iter()
                 .collect();
             if col == "j_explore"
                 && let Some(mean) = log.column("j_target")
             {
-                series.push(Series { label: format!("{name} target"), x: x.clone(), mean, band: None });
+                series.push(Series {
+                    label: format!("{name} target"),
+                    x: x.clone(),
+                    mean,
+                    band: None,
+                });
             }
-            Panel { title: title.into(), x_label: "iteration".into(), y_label: y.into(), series, hlines: Vec::new() }
+            Panel {
+                title: title.into(),
+                x_label: "iteration".into(),
+                y_label: y.into(),
+                series,
+                hlines: Vec::new(),
+            }
         })
         .collect();
-    let complete = if runfmt::is_complete(dir) { "" } else { " (incomplete run)" };
-    Ok(Figure { title: format!("{}{complete}", dir.display()), panels, columns: 2 })
+    let complete = if runfmt::is_complete(dir) {
+        ""
+    } else {
+        " (incomplete run)"
+    };
+    Ok(Figure {
+        title: format!("{}{complete}", dir.display()),
+        panels,
+        columns: 2,
+    })
 }
 
 fn sweep(dir: &Path, file: &SweepFile) -> Result<Figure, CliError> {
@@ -71,7 +103,10 @@ fn sweep(dir: &Path, file: &SweepFile) -> Result<Figure, CliError> {
         }
     }
     if groups.is_empty() {
-        return Err(CliError::usage(format!("{} has no started run yet", dir.display())));
+        return Err(CliError::usage(format!(
+            "{} has no started run yet",
+            dir.display()
+        )));
     }
     let panels = PANELS
         .iter()
@@ -80,15 +115,33 @@ fn sweep(dir: &Path, file: &SweepFile) -> Result<Figure, CliError> {
                 .iter()
                 .filter_map(|(label, logs)| {
                     let curves: Vec<Vec<f64>> = logs.iter().filter_map(|l| l.column(col)).collect();
-                    let x = logs.iter().filter_map(|l| l.column("iteration")).min_by_key(Vec::len)?;
+                    let x = logs
+                        .iter()
+                        .filter_map(|l| l.column("iteration"))
+                        .min_by_key(Vec::len)?;
                     let (mean, band) = mean_band(&curves);
-                    Some(Series { label: label.clone(), x: x[..mean.len()].to_vec(), mean, band })
+                    Some(Series {
+                        label: label.clone(),
+                        x: x[..mean.len()].to_vec(),
+                        mean,
+                        band,
+                    })
                 })
                 .collect();
-            Panel { title: title.into(), x_label: "iteration".into(), y_label: y.into(), series, hlines: Vec::new() }
+            Panel {
+                title: title.into(),
+                x_label: "iteration".into(),
+                y_label: y.into(),
+                series,
+                hlines: Vec::new(),
+            }
         })
         .collect();
-    Ok(Figure { title: format!("{} (mean and 95% band across seeds)", dir.display()), panels, columns: 2 })
+    Ok(Figure {
+        title: format!("{} (mean and 95% band across seeds)", dir.display()),
+        panels,
+        columns: 2,
+    })
 }
 
 /// Runs `sepg plot`.
@@ -98,16 +151,25 @@ fn sweep(dir: &Path, file: &SweepFile) -> Result<Figure, CliError> {
 /// that is not .png or .svg; failure (exit 1) when drawing or writing fails.
 pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     if let Some(out) = &args.out
-        && !matches!(out.extension().and_then(|e| e.to_str()), Some("png" | "svg"))
+        && !matches!(
+            out.extension().and_then(|e| e.to_str()),
+            Some("png" | "svg")
+        )
     {
-        return Err(CliError::usage(format!("{}: figures are written as .png or .svg", out.display())));
+        return Err(CliError::usage(format!(
+            "{}: figures are written as .png or .svg",
+            out.display()
+        )));
     }
     let fig = if args.dir.join(SWEEP_FILE).is_file() {
         sweep(&args.dir, &SweepFile::read(&args.dir)?)?
     } else if args.dir.join(runfmt::CONFIG_FILE).is_file() {
         one_run(&args.dir)?
     } else {
-        return Err(CliError::usage(format!("{} is neither a run folder nor a sweep folder", args.dir.display())));
+        return Err(CliError::usage(format!(
+            "{} is neither a run folder nor a sweep folder",
+            args.dir.display()
+        )));
     };
     let written = match &args.out {
         Some(out) => {

@@ -2,12 +2,10 @@
 //! sequence (Mountain Car, gymnasium `MountainCarContinuous-v0` rules of SPEC §1).
 
 use clap::Args;
-use serde::Serialize;
 use sepg_mdp::env::Environment;
-use sepg_mdp::mountain_car::{
-    MAX_POSITION, MAX_SPEED, MIN_POSITION, MountainCar, TIME_LIMIT,
-};
+use sepg_mdp::mountain_car::{MAX_POSITION, MAX_SPEED, MIN_POSITION, MountainCar, TIME_LIMIT};
 use sepg_mdp::rng::rng_from_seed;
+use serde::Serialize;
 
 use crate::cli::CliError;
 use crate::output::to_json_line;
@@ -96,10 +94,22 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     if args.json {
         print!("{}", to_json_line(&t)?);
     } else {
-        println!("{:>5} {:>22} {:>22} {:>14}", "step", "position", "velocity", "reward");
-        println!("{:>5} {:>22.17} {:>22.17}", 0, t.positions[0], t.velocities[0]);
+        println!(
+            "{:>5} {:>22} {:>22} {:>14}",
+            "step", "position", "velocity", "reward"
+        );
+        println!(
+            "{:>5} {:>22.17} {:>22.17}",
+            0, t.positions[0], t.velocities[0]
+        );
         for (i, r) in t.rewards.iter().enumerate() {
-            println!("{:>5} {:>22.17} {:>22.17} {:>14.6}", i + 1, t.positions[i + 1], t.velocities[i + 1], r);
+            println!(
+                "{:>5} {:>22.17} {:>22.17} {:>14.6}",
+                i + 1,
+                t.positions[i + 1],
+                t.velocities[i + 1],
+                r
+            );
         }
         match t.terminated_at {
             Some(i) => println!("terminated at action {i}"),

@@ -22,10 +22,30 @@ use crate::output::write_atomic;
 /// 1.0, the columns in [`TABLE_VARIANTS`] order (Adam 1e-4, 1e-5, 1e-6; constant step 1e-4,
 /// 1e-5, 1e-6; MI; LB-I; LB-II; LV; ZV). Values to compare against, not expectations.
 pub const THESIS_TABLE_5_1: [(f64, [f64; 11]); 4] = [
-    (0.1, [0.126, 0.432, 0.506, 0.132, 0.026, 0.228, 0.515, 0.510, 0.368, 0.429, 0.435]),
-    (0.2, [0.08, 0.429, 0.506, 0.124, 0.018, 0.201, 0.515, 0.494, 0.039, 0.028, 0.056]),
-    (0.5, [0.061, 0.428, 0.506, 0.122, 0.012, 0.125, 0.511, 0.29, 0.009, 0.01, 0.006]),
-    (1.0, [0.046, 0.422, 0.505, 0.122, 0.011, 0.069, 0.497, 0.01, 0.021, 0.021, 0.028]),
+    (
+        0.1,
+        [
+            0.126, 0.432, 0.506, 0.132, 0.026, 0.228, 0.515, 0.510, 0.368, 0.429, 0.435,
+        ],
+    ),
+    (
+        0.2,
+        [
+            0.08, 0.429, 0.506, 0.124, 0.018, 0.201, 0.515, 0.494, 0.039, 0.028, 0.056,
+        ],
+    ),
+    (
+        0.5,
+        [
+            0.061, 0.428, 0.506, 0.122, 0.012, 0.125, 0.511, 0.29, 0.009, 0.01, 0.006,
+        ],
+    ),
+    (
+        1.0,
+        [
+            0.046, 0.422, 0.505, 0.122, 0.011, 0.069, 0.497, 0.01, 0.021, 0.021, 0.028,
+        ],
+    ),
 ];
 
 /// Variant names of Table 5.1, in the thesis's column order.
@@ -123,13 +143,21 @@ pub struct ReproduceArgs {
 }
 
 fn variant(name: &str, algo: AlgoName) -> RunSpec {
-    RunSpec { name: Some(name.to_owned()), algo: Some(algo), ..RunSpec::default() }
+    RunSpec {
+        name: Some(name.to_owned()),
+        algo: Some(algo),
+        ..RunSpec::default()
+    }
 }
 
 /// The sweep of an experiment.
 fn sweep_spec(args: &ReproduceArgs) -> Result<SweepSpec, CliError> {
     let presets = match (args.what, args.preset) {
-        (Experiment::Fig54, Some(_)) => return Err(CliError::usage("--preset does not apply to fig-5.4 (Mountain Car)")),
+        (Experiment::Fig54, Some(_)) => {
+            return Err(CliError::usage(
+                "--preset does not apply to fig-5.4 (Mountain Car)",
+            ));
+        }
         (Experiment::Fig54, None) => vec![EnvName::MountainCar],
         (_, Some(LqgPreset::Lqg)) => vec![EnvName::Lqg],
         (_, Some(LqgPreset::Lqg1d)) => vec![EnvName::Lqg1d],
@@ -138,7 +166,13 @@ fn sweep_spec(args: &ReproduceArgs) -> Result<SweepSpec, CliError> {
     if args.seeds == 0 {
         return Err(CliError::usage("--seeds must be at least 1"));
     }
-    let iterations = args.iterations.unwrap_or(if args.what == Experiment::Fig54 { 1000 } else { 10_000 });
+    let iterations = args
+        .iterations
+        .unwrap_or(if args.what == Experiment::Fig54 {
+            1000
+        } else {
+            10_000
+        });
     let base = RunSpec {
         iterations: Some(iterations),
         delta: Some(args.delta),
@@ -147,9 +181,18 @@ fn sweep_spec(args: &ReproduceArgs) -> Result<SweepSpec, CliError> {
         ..RunSpec::default()
     };
     let sepg = |name: &str, algo| variant(name, algo);
-    let adam = |lr: f64, name: &str| RunSpec { lr: Some(lr), ..variant(name, AlgoName::GpomdpAdam) };
-    let constant = |a: f64, name: &str| RunSpec { alpha: Some(a), ..variant(name, AlgoName::GpomdpConst) };
-    let sim = |nu: f64, name: &str| RunSpec { nu: Some(nu), ..variant(name, AlgoName::SepgSim) };
+    let adam = |lr: f64, name: &str| RunSpec {
+        lr: Some(lr),
+        ..variant(name, AlgoName::GpomdpAdam)
+    };
+    let constant = |a: f64, name: &str| RunSpec {
+        alpha: Some(a),
+        ..variant(name, AlgoName::GpomdpConst)
+    };
+    let sim = |nu: f64, name: &str| RunSpec {
+        nu: Some(nu),
+        ..variant(name, AlgoName::SepgSim)
+    };
     let (variants, sigma0) = match args.what {
         Experiment::Table51 => (
             vec![
@@ -167,20 +210,39 @@ fn sweep_spec(args: &ReproduceArgs) -> Result<SweepSpec, CliError> {
             ],
             SIGMA0.to_vec(),
         ),
-        Experiment::Fig51 => (vec![sepg("mi", AlgoName::SepgMi), sepg("lb1", AlgoName::SepgLb1)], vec![args.fig_sigma0]),
+        Experiment::Fig51 => (
+            vec![sepg("mi", AlgoName::SepgMi), sepg("lb1", AlgoName::SepgLb1)],
+            vec![args.fig_sigma0],
+        ),
         Experiment::Fig52 => (
-            vec![sepg("lb2", AlgoName::SepgLb2), sepg("lv", AlgoName::SepgLv), sepg("zv", AlgoName::SepgZv)],
+            vec![
+                sepg("lb2", AlgoName::SepgLb2),
+                sepg("lv", AlgoName::SepgLv),
+                sepg("zv", AlgoName::SepgZv),
+            ],
             vec![args.fig_sigma0],
         ),
         Experiment::Fig53 => (
-            vec![sepg("zv", AlgoName::SepgZv), sim(1.0 / 3.0, "sim-1of3"), sim(0.5, "sim-1of2"), sim(2.0 / 3.0, "sim-2of3")],
+            vec![
+                sepg("zv", AlgoName::SepgZv),
+                sim(1.0 / 3.0, "sim-1of3"),
+                sim(0.5, "sim-1of2"),
+                sim(2.0 / 3.0, "sim-2of3"),
+            ],
             vec![args.fig_sigma0],
         ),
-        Experiment::Fig54 => {
-            (vec![sepg("zv", AlgoName::SepgZv), adam(1e-3, "adam-1e-3")], vec![0.2])
-        }
+        Experiment::Fig54 => (
+            vec![sepg("zv", AlgoName::SepgZv), adam(1e-3, "adam-1e-3")],
+            vec![0.2],
+        ),
     };
-    Ok(SweepSpec { presets, seeds: Seeds::Count(args.seeds), sigma0, base, variant: variants })
+    Ok(SweepSpec {
+        presets,
+        seeds: Seeds::Count(args.seeds),
+        sigma0,
+        base,
+        variant: variants,
+    })
 }
 
 /// Runs `sepg reproduce`.
@@ -191,7 +253,10 @@ fn sweep_spec(args: &ReproduceArgs) -> Result<SweepSpec, CliError> {
 pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
     let spec = sweep_spec(args)?;
     let (file, resolved) = sweep::expand(&spec, Shard { index: 0, count: 1 })?;
-    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("sepg-{}", args.what.name())));
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("sepg-{}", args.what.name())));
     let stats = if args.resume {
         let existing = SweepFile::read(&dir)?;
         if existing.sweep_id != file.sweep_id {
@@ -248,26 +313,48 @@ fn load(dir: &Path, file: &SweepFile) -> Result<Vec<Loaded>, CliError> {
                 .map_err(|e| CliError::failure(format!("{}: {e}", run_dir.display())))?;
             let summary: Summary = serde_json::from_str(&text)
                 .map_err(|e| CliError::failure(format!("{}: {e}", run_dir.display())))?;
-            Ok(Loaded { preset: r.preset, variant: r.variant.clone(), sigma0: r.sigma0, summary, log: Log::read_run(&run_dir)? })
+            Ok(Loaded {
+                preset: r.preset,
+                variant: r.variant.clone(),
+                sigma0: r.sigma0,
+                summary,
+                log: Log::read_run(&run_dir)?,
+            })
         })
         .collect()
 }
 
+fn seed_count(seeds: &Seeds) -> u64 {
+    match seeds {
+        Seeds::Count(n) => *n,
+        Seeds::List(v) => v.len() as u64,
+    }
+}
+
 /// A CSV cell: shortest round-trip decimal, empty when undefined.
 fn csv_num(x: f64) -> String {
-    if x.is_finite() { format!("{x:?}") } else { String::new() }
+    if x.is_finite() {
+        format!("{x:?}")
+    } else {
+        String::new()
+    }
 }
 
 fn fmt3(x: f64) -> String {
-    if x.is_finite() { format!("{x:.3}") } else { "—".into() }
+    if x.is_finite() {
+        format!("{x:.3}")
+    } else {
+        "—".into()
+    }
 }
 
 /// Table 5.1 as markdown and CSV.
-fn table(file: &SweepFile, runs: &[Loaded], args: &ReproduceArgs) -> Result<(String, String), CliError> {
-    let seeds = match &file.spec.seeds {
-        Seeds::Count(n) => *n,
-        Seeds::List(v) => v.len() as u64,
-    };
+fn table(
+    file: &SweepFile,
+    runs: &[Loaded],
+    args: &ReproduceArgs,
+) -> Result<(String, String), CliError> {
+    let seeds = seed_count(&file.spec.seeds);
     let iterations = runs.first().map_or(0, |r| r.summary.iterations);
     let mut md = String::new();
     let mut csv = String::from("preset,sigma0,variant,seeds,iterations,mean,sd,ucb95,thesis\n");
@@ -319,13 +406,28 @@ fn table(file: &SweepFile, runs: &[Loaded], args: &ReproduceArgs) -> Result<(Str
 
 /// Curves of `column` (x = iteration or trajectories) for every run of (preset, variant)
 /// at σ⁰, as mean and band across seeds.
-fn series(runs: &[Loaded], preset: EnvName, variant: &str, sigma0: f64, x_col: &str, y: &dyn Fn(&Log) -> Option<Vec<f64>>) -> Option<Series> {
-    let group: Vec<&Loaded> = runs.iter().filter(|r| r.preset == preset && r.variant == variant && r.sigma0 == sigma0).collect();
+fn series(
+    runs: &[Loaded],
+    preset: EnvName,
+    variant: &str,
+    sigma0: f64,
+    x_col: &str,
+    y: &dyn Fn(&Log) -> Option<Vec<f64>>,
+) -> Option<Series> {
+    let group: Vec<&Loaded> = runs
+        .iter()
+        .filter(|r| r.preset == preset && r.variant == variant && r.sigma0 == sigma0)
+        .collect();
     let curves: Vec<Vec<f64>> = group.iter().filter_map(|r| y(&r.log)).collect();
     let x = group.first()?.log.column(x_col)?;
     let (mean, band) = mean_band(&curves);
     let x = x[..mean.len().min(x.len())].to_vec();
-    Some(Series { label: variant.to_owned(), x, mean, band })
+    Some(Series {
+        label: variant.to_owned(),
+        x,
+        mean,
+        band,
+    })
 }
 
 fn col(name: &'static str) -> impl Fn(&Log) -> Option<Vec<f64>> {
@@ -338,26 +440,53 @@ fn guarantee(log: &Log) -> Option<Vec<f64>> {
     let je = log.column("j_explore")?;
     let jt = log.column("j_target")?;
     let mut sum = 0.0;
-    Some(je.iter().zip(&jt).enumerate().map(|(k, (a, b))| {
-        sum += 0.5 * (a + b);
-        sum / (k + 1) as f64
-    }).collect())
+    Some(
+        je.iter()
+            .zip(&jt)
+            .enumerate()
+            .map(|(k, (a, b))| {
+                sum += 0.5 * (a + b);
+                sum / (k + 1) as f64
+            })
+            .collect(),
+    )
 }
 
-fn figures(what: Experiment, file: &SweepFile, runs: &[Loaded], args: &ReproduceArgs) -> Vec<(String, Figure)> {
+fn figures(
+    what: Experiment,
+    file: &SweepFile,
+    runs: &[Loaded],
+    args: &ReproduceArgs,
+) -> Vec<(String, Figure)> {
     let sigma0 = file.spec.sigma0[0];
-    let names: Vec<String> = file.spec.variant.iter().filter_map(|v| v.name.clone()).collect();
+    let names: Vec<String> = file
+        .spec
+        .variant
+        .iter()
+        .filter_map(|v| v.name.clone())
+        .collect();
     let mut out = Vec::new();
     for &preset in &file.spec.presets {
-        let x_col = if what == Experiment::Fig53 { "trajectories" } else { "iteration" };
+        let x_col = if what == Experiment::Fig53 {
+            "trajectories"
+        } else {
+            "iteration"
+        };
         let panel = |title: &str, y_label: &str, y: &dyn Fn(&Log) -> Option<Vec<f64>>| Panel {
             title: title.to_owned(),
             x_label: x_col.to_owned(),
             y_label: y_label.to_owned(),
-            series: names.iter().filter_map(|n| series(runs, preset, n, sigma0, x_col, y)).collect(),
+            series: names
+                .iter()
+                .filter_map(|n| series(runs, preset, n, sigma0, x_col, y))
+                .collect(),
             hlines: Vec::new(),
         };
-        let v_star = runs.iter().find(|r| r.preset == preset).and_then(|r| r.summary.v_star.as_ref()).map(|v| v[0]);
+        let v_star = runs
+            .iter()
+            .find(|r| r.preset == preset)
+            .and_then(|r| r.summary.v_star.as_ref())
+            .map(|v| v[0]);
         let with_vstar = |mut p: Panel| {
             if let Some(v) = v_star {
                 p.hlines.push(("v*".into(), v));
@@ -401,16 +530,31 @@ fn figures(what: Experiment, file: &SweepFile, runs: &[Loaded], args: &Reproduce
                 panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
             ],
         };
-        let seeds = runs.iter().filter(|r| r.preset == preset).map(|r| r.summary.iterations).count() / names.len().max(1);
+        let seeds = seed_count(&file.spec.seeds);
         let title = format!(
             "{} — {}, σ⁰ = {sigma0}, {seeds} seeds, δ = {} (mean, 95% band)",
             what.name(),
             preset.name(),
             args.delta
         );
-        let columns = if panels.len() > 4 { 3 } else { panels.len().min(2) };
-        let stem = if what == Experiment::Fig54 { what.name().to_owned() } else { format!("{}-{}", what.name(), preset.name()) };
-        out.push((stem, Figure { title, panels, columns }));
+        let columns = if panels.len() > 4 {
+            3
+        } else {
+            panels.len().min(2)
+        };
+        let stem = if what == Experiment::Fig54 {
+            what.name().to_owned()
+        } else {
+            format!("{}-{}", what.name(), preset.name())
+        };
+        out.push((
+            stem,
+            Figure {
+                title,
+                panels,
+                columns,
+            },
+        ));
     }
     out
 }

@@ -58,11 +58,20 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if args.checkpoint_every == 0 {
         return Err(CliError::usage("--checkpoint-every must be at least 1"));
     }
-    let opts = RunOptions { checkpoint_every: args.checkpoint_every, progress: !args.quiet };
+    let opts = RunOptions {
+        checkpoint_every: args.checkpoint_every,
+        progress: !args.quiet,
+    };
     runfmt::install_interrupt_handler();
     let (dir, summary) = if let Some(dir) = &args.resume {
-        if args.config.is_some() || args.out.is_some() || args.force || args.spec != RunSpec::default() {
-            return Err(CliError::usage("--resume takes no other options than --quiet and --checkpoint-every"));
+        if args.config.is_some()
+            || args.out.is_some()
+            || args.force
+            || args.spec != RunSpec::default()
+        {
+            return Err(CliError::usage(
+                "--resume takes no other options than --quiet and --checkpoint-every",
+            ));
         }
         (dir.clone(), runfmt::resume(dir, opts)?)
     } else {
@@ -71,9 +80,15 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             None => RunSpec::default(),
         };
         // A configuration copied from an earlier run is re-resolved by this version.
-        let merged = RunSpec { sepg_version: None, ..file.overlay(&args.spec) };
+        let merged = RunSpec {
+            sepg_version: None,
+            ..file.overlay(&args.spec)
+        };
         let resolved = merged.resolve()?;
-        let dir = args.out.clone().ok_or_else(|| CliError::usage("--out DIR is required"))?;
+        let dir = args
+            .out
+            .clone()
+            .ok_or_else(|| CliError::usage("--out DIR is required"))?;
         runfmt::check_out_dir(&dir, args.force, &RUN_FILES)?;
         (dir.clone(), runfmt::start(&dir, &resolved, opts)?)
     };

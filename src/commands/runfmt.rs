@@ -26,7 +26,6 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::{Deserialize, Deserializer, Serialize};
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::executor::Solver;
 use sepg_algo::core::record::Record;
@@ -36,6 +35,7 @@ use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
 use sepg_mdp::mountain_car::MountainCar;
 use sepg_mdp::oracle::ClosedFormOracle;
+use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::cli::CliError;
 use crate::output::{to_json_line, write_atomic};
@@ -54,7 +54,13 @@ pub const SUMMARY_FILE: &str = "summary.json";
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Files a run writes; `--force` removes exactly these from an existing folder.
-pub const RUN_FILES: [&str; 5] = [CONFIG_FILE, CHECKPOINT_FILE, PARTIAL_LOG_FILE, LOG_FILE, SUMMARY_FILE];
+pub const RUN_FILES: [&str; 5] = [
+    CONFIG_FILE,
+    CHECKPOINT_FILE,
+    PARTIAL_LOG_FILE,
+    LOG_FILE,
+    SUMMARY_FILE,
+];
 
 /// Environment presets accepted by `--env`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ValueEnum)]
@@ -202,7 +208,9 @@ impl<'de> Deserialize<'de> for Values {
         match Raw::deserialize(d) {
             Ok(Raw::One(x)) => Ok(Values::One(x)),
             Ok(Raw::Many(v)) => Ok(Values::Many(v)),
-            Err(_) => Err(serde::de::Error::custom("expected a number or an array of numbers")),
+            Err(_) => Err(serde::de::Error::custom(
+                "expected a number or an array of numbers",
+            )),
         }
     }
 }
@@ -212,7 +220,9 @@ fn parse_values(s: &str) -> Result<Values, String> {
     match v {
         Ok(v) if v.len() == 1 => Ok(Values::One(v[0])),
         Ok(v) => Ok(Values::Many(v)),
-        Err(e) => Err(format!("{s:?} is not a comma-separated list of numbers: {e}")),
+        Err(e) => Err(format!(
+            "{s:?} is not a comma-separated list of numbers: {e}"
+        )),
     }
 }
 
@@ -342,7 +352,8 @@ impl RunSpec {
     pub fn from_file(path: &Path) -> Result<RunSpec, CliError> {
         let text = fs::read_to_string(path)
             .map_err(|e| CliError::usage(format!("cannot read {}: {e}", path.display())))?;
-        toml::from_str(&text).map_err(|e| CliError::usage(format!("{}: {}", path.display(), toml_message(&e))))
+        toml::from_str(&text)
+            .map_err(|e| CliError::usage(format!("{}: {}", path.display(), toml_message(&e))))
     }
 
     /// Resolves every default, validates the configuration (the checks of
@@ -356,13 +367,24 @@ impl RunSpec {
         let algo = self.algo.unwrap_or(AlgoName::SepgZv);
         let gradients = self.gradients.unwrap_or(GradientsName::Sampled);
         let reject = |set: bool, what: &str, why: &str| {
-            if set { Err(CliError::usage(format!("option {what} does not apply {why}"))) } else { Ok(()) }
+            if set {
+                Err(CliError::usage(format!(
+                    "option {what} does not apply {why}"
+                )))
+            } else {
+                Ok(())
+            }
         };
-        let algo_str = algo.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default();
+        let algo_str = algo
+            .to_possible_value()
+            .map(|v| v.get_name().to_owned())
+            .unwrap_or_default();
         let for_algo = format!("to algorithm {algo_str}");
         let env = build_env(env_name, self.features.as_deref())?;
         let features = match env_name {
-            EnvName::MountainCar => Some(self.features.clone().unwrap_or_else(|| "state-bias".into())),
+            EnvName::MountainCar => {
+                Some(self.features.clone().unwrap_or_else(|| "state-bias".into()))
+            }
             _ => {
                 reject(self.features.is_some(), "features", "to LQG environments")?;
                 None
@@ -370,29 +392,52 @@ impl RunSpec {
         };
         let uses_nu = matches!(algo, AlgoName::SepgLb1 | AlgoName::SepgSim)
             || (algo == AlgoName::SepgNaiveW
-                && matches!(self.requirement, Some(RequirementName::Lb1 | RequirementName::Sim)));
+                && matches!(
+                    self.requirement,
+                    Some(RequirementName::Lb1 | RequirementName::Sim)
+                ));
         reject(!uses_nu && self.nu.is_some(), "nu", &for_algo)?;
-        reject(algo != AlgoName::SepgNaiveW && self.requirement.is_some(), "requirement", &for_algo)?;
+        reject(
+            algo != AlgoName::SepgNaiveW && self.requirement.is_some(),
+            "requirement",
+            &for_algo,
+        )?;
         let is_const = algo == AlgoName::GpomdpConst;
         let is_adam = algo == AlgoName::GpomdpAdam;
-        reject(!is_const && (self.alpha.is_some() || self.beta.is_some()), "alpha/beta", &for_algo)?;
-        reject(!is_adam && (self.lr.is_some() || self.lr_w.is_some()), "lr/lr-w", &for_algo)?;
+        reject(
+            !is_const && (self.alpha.is_some() || self.beta.is_some()),
+            "alpha/beta",
+            &for_algo,
+        )?;
+        reject(
+            !is_adam && (self.lr.is_some() || self.lr_w.is_some()),
+            "lr/lr-w",
+            &for_algo,
+        )?;
         let exact = gradients == GradientsName::Exact;
         reject(exact && self.delta.is_some(), "delta", "to exact gradients")?;
         reject(
-            exact && (self.estimator.is_some() || self.baseline.is_some() || self.baseline_fit.is_some()),
+            exact
+                && (self.estimator.is_some()
+                    || self.baseline.is_some()
+                    || self.baseline_fit.is_some()),
             "estimator/baseline/baseline-fit",
             "to exact gradients",
         )?;
         let nu = uses_nu.then(|| self.nu.unwrap_or(0.5));
-        let requirement = (algo == AlgoName::SepgNaiveW).then(|| self.requirement.unwrap_or(RequirementName::Zv));
+        let requirement =
+            (algo == AlgoName::SepgNaiveW).then(|| self.requirement.unwrap_or(RequirementName::Zv));
         let req_of = |r: RequirementName| match r {
             RequirementName::Mi => Requirement::Mi,
-            RequirementName::Lb1 => Requirement::LbI { nu: nu.unwrap_or(0.5) },
+            RequirementName::Lb1 => Requirement::LbI {
+                nu: nu.unwrap_or(0.5),
+            },
             RequirementName::Lb2 => Requirement::LbII,
             RequirementName::Lv => Requirement::Lv,
             RequirementName::Zv => Requirement::Zv,
-            RequirementName::Sim => Requirement::Sim { nu: nu.unwrap_or(0.5) },
+            RequirementName::Sim => Requirement::Sim {
+                nu: nu.unwrap_or(0.5),
+            },
         };
         let need = |v: Option<f64>, flag: &str| {
             v.ok_or_else(|| CliError::usage(format!("algorithm {algo_str} needs --{flag}")))
@@ -415,8 +460,13 @@ impl RunSpec {
             AlgoName::SepgLv => Algorithm::Sepg(Requirement::Lv),
             AlgoName::SepgZv => Algorithm::Sepg(Requirement::Zv),
             AlgoName::SepgSim => Algorithm::Sepg(req_of(RequirementName::Sim)),
-            AlgoName::SepgNaiveW => Algorithm::SepgNaiveW(req_of(requirement.unwrap_or(RequirementName::Zv))),
-            AlgoName::GpomdpConst => Algorithm::GpomdpConst { alpha: alpha.unwrap_or(0.0), beta: beta.unwrap_or(0.0) },
+            AlgoName::SepgNaiveW => {
+                Algorithm::SepgNaiveW(req_of(requirement.unwrap_or(RequirementName::Zv)))
+            }
+            AlgoName::GpomdpConst => Algorithm::GpomdpConst {
+                alpha: alpha.unwrap_or(0.0),
+                beta: beta.unwrap_or(0.0),
+            },
             AlgoName::GpomdpAdam => Algorithm::adam(lr.unwrap_or(0.0), lr_w.unwrap_or(0.0)),
             AlgoName::Adastep => Algorithm::AdaStep,
         };
@@ -450,12 +500,26 @@ impl RunSpec {
         });
         let dim_w = env.action_dim();
         let dim_v = dim_w * env.feature_dim();
-        let v0 = self.v0.clone().unwrap_or(Values::One(-0.1)).expand(dim_v, "v0")?;
-        let sigma0 = self.sigma0.clone().unwrap_or(Values::One(1.0)).expand(dim_w, "sigma0")?;
-        let budget0 = self.budget0.unwrap_or(if env_name == EnvName::MountainCar { 1.0 } else { 0.0 });
+        let v0 = self
+            .v0
+            .clone()
+            .unwrap_or(Values::One(-0.1))
+            .expand(dim_v, "v0")?;
+        let sigma0 = self
+            .sigma0
+            .clone()
+            .unwrap_or(Values::One(1.0))
+            .expand(dim_w, "sigma0")?;
+        let budget0 = self.budget0.unwrap_or(if env_name == EnvName::MountainCar {
+            1.0
+        } else {
+            0.0
+        });
         let batch = self.batch.unwrap_or(100);
         if batch < 2 {
-            return Err(CliError::usage(format!("batch N = {batch} must be at least 2")));
+            return Err(CliError::usage(format!(
+                "batch N = {batch} must be at least 2"
+            )));
         }
         let horizon = self.horizon.unwrap_or(env.constants().horizon);
         let iterations = self.iterations.unwrap_or(10_000);
@@ -477,8 +541,16 @@ impl RunSpec {
             seed,
             initial_budget: budget0,
         };
-        let checked = config.check().map_err(|e| CliError::usage(format!("invalid configuration: {e}")))?;
-        let one_or_many = |v: Vec<f64>| if v.len() == 1 { Values::One(v[0]) } else { Values::Many(v) };
+        let checked = config
+            .check()
+            .map_err(|e| CliError::usage(format!("invalid configuration: {e}")))?;
+        let one_or_many = |v: Vec<f64>| {
+            if v.len() == 1 {
+                Values::One(v[0])
+            } else {
+                Values::Many(v)
+            }
+        };
         let spec = RunSpec {
             name: Some(self.name.clone().unwrap_or_else(|| algo_str.clone())),
             env: Some(env_name),
@@ -503,9 +575,17 @@ impl RunSpec {
             baseline: estimator.map(|e| e.1),
             baseline_fit: estimator.map(|e| e.2),
             log_every: Some(log_every),
-            sepg_version: Some(self.sepg_version.clone().unwrap_or_else(|| VERSION.to_owned())),
+            sepg_version: Some(
+                self.sepg_version
+                    .clone()
+                    .unwrap_or_else(|| VERSION.to_owned()),
+            ),
         };
-        Ok(Resolved { spec, checked, dims: (dim_v, dim_w) })
+        Ok(Resolved {
+            spec,
+            checked,
+            dims: (dim_v, dim_w),
+        })
     }
 }
 
@@ -525,12 +605,14 @@ fn build_env(name: EnvName, features: Option<&str>) -> Result<AnyEnv, CliError> 
         EnvName::MountainCar => AnyEnv::MountainCar(match features.unwrap_or("state-bias") {
             "state-bias" => MountainCar::state_bias(),
             f => {
-                let bad = || CliError::usage(format!("features {f:?}: expected state-bias or rbf:KxV"));
+                let bad =
+                    || CliError::usage(format!("features {f:?}: expected state-bias or rbf:KxV"));
                 let grid = f.strip_prefix("rbf:").ok_or_else(bad)?;
                 let (k, v) = grid.split_once('x').ok_or_else(bad)?;
                 let k: usize = k.parse().map_err(|_| bad())?;
                 let v: usize = v.parse().map_err(|_| bad())?;
-                MountainCar::rbf([k, v], true).map_err(|e| CliError::usage(format!("features {f:?}: {e}")))?
+                MountainCar::rbf([k, v], true)
+                    .map_err(|e| CliError::usage(format!("features {f:?}: {e}")))?
             }
         }),
     })
@@ -553,14 +635,19 @@ impl Resolved {
     /// # Errors
     /// Failure if serialisation fails.
     pub fn toml(&self) -> Result<String, CliError> {
-        toml::to_string(&self.spec).map_err(|e| CliError::failure(format!("cannot serialise the configuration: {e}")))
+        toml::to_string(&self.spec)
+            .map_err(|e| CliError::failure(format!("cannot serialise the configuration: {e}")))
     }
 
     /// v* of the LQG environments (the unclipped infinite-horizon optimum, SPEC §1), `None`
     /// for other environments.
     pub fn v_star(&self) -> Option<Vec<f64>> {
         match &self.checked.config().env {
-            AnyEnv::Lqg(e) => ClosedFormOracle::new(e.model()).ok()?.optimal_gain().ok().map(|g| g.v),
+            AnyEnv::Lqg(e) => ClosedFormOracle::new(e.model())
+                .ok()?
+                .optimal_gain()
+                .ok()
+                .map(|g| g.v),
             AnyEnv::MountainCar(_) => None,
         }
     }
@@ -577,7 +664,11 @@ impl Resolved {
 }
 
 fn indexed(name: &str, dim: usize) -> Vec<String> {
-    if dim == 1 { vec![name.to_owned()] } else { (0..dim).map(|i| format!("{name}_{i}")).collect() }
+    if dim == 1 {
+        vec![name.to_owned()]
+    } else {
+        (0..dim).map(|i| format!("{name}_{i}")).collect()
+    }
 }
 
 /// The header of `log.csv` for `dim_v` mean parameters and `dim_w` standard deviations.
@@ -797,9 +888,13 @@ pub fn check_out_dir(dir: &Path, force: bool, files: &[&str]) -> Result<(), CliE
         return Ok(());
     }
     if !dir.is_dir() {
-        return Err(CliError::usage(format!("{} exists and is not a folder", dir.display())));
+        return Err(CliError::usage(format!(
+            "{} exists and is not a folder",
+            dir.display()
+        )));
     }
-    let mut entries = fs::read_dir(dir).map_err(|e| CliError::usage(format!("cannot read {}: {e}", dir.display())))?;
+    let mut entries = fs::read_dir(dir)
+        .map_err(|e| CliError::usage(format!("cannot read {}: {e}", dir.display())))?;
     if entries.next().is_some() && !force {
         return Err(CliError::usage(format!(
             "output folder {} is not empty (use --force to overwrite its run files)",
@@ -829,7 +924,10 @@ pub fn is_complete(dir: &Path) -> bool {
 pub fn load_resolved(dir: &Path) -> Result<Resolved, CliError> {
     let path = dir.join(CONFIG_FILE);
     if !path.is_file() {
-        return Err(CliError::usage(format!("{} is not a run folder (no {CONFIG_FILE})", dir.display())));
+        return Err(CliError::usage(format!(
+            "{} is not a run folder (no {CONFIG_FILE})",
+            dir.display()
+        )));
     }
     let spec = RunSpec::from_file(&path)?;
     if let Some(v) = &spec.sepg_version
@@ -877,8 +975,12 @@ pub fn resume(dir: &Path, opts: RunOptions) -> Result<Summary, CliError> {
     let ck_path = dir.join(CHECKPOINT_FILE);
     let text = fs::read_to_string(&ck_path)
         .map_err(|e| CliError::usage(format!("cannot read {}: {e}", ck_path.display())))?;
-    let ck: Checkpoint = serde_json::from_str(&text)
-        .map_err(|e| CliError::usage(format!("{} is not a valid checkpoint: {e}", ck_path.display())))?;
+    let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| {
+        CliError::usage(format!(
+            "{} is not a valid checkpoint: {e}",
+            ck_path.display()
+        ))
+    })?;
     let partial = dir.join(PARTIAL_LOG_FILE);
     let finished = dir.join(LOG_FILE);
     if !partial.exists() && finished.is_file() && ck.state.iteration == resolved.iterations() {
@@ -889,7 +991,10 @@ pub fn resume(dir: &Path, opts: RunOptions) -> Result<Summary, CliError> {
         .write(true)
         .open(&partial)
         .map_err(|e| CliError::usage(format!("cannot open {}: {e}", partial.display())))?;
-    let len = file.metadata().map_err(|e| io_fail("read", &partial, e))?.len();
+    let len = file
+        .metadata()
+        .map_err(|e| io_fail("read", &partial, e))?
+        .len();
     if len < ck.log_bytes {
         return Err(CliError::usage(format!(
             "{} is shorter ({len} bytes) than its checkpoint says ({} bytes)",
@@ -897,7 +1002,8 @@ pub fn resume(dir: &Path, opts: RunOptions) -> Result<Summary, CliError> {
             ck.log_bytes
         )));
     }
-    file.set_len(ck.log_bytes).map_err(|e| io_fail("truncate", &partial, e))?;
+    file.set_len(ck.log_bytes)
+        .map_err(|e| io_fail("truncate", &partial, e))?;
     file.sync_all().map_err(|e| io_fail("sync", &partial, e))?;
     drive(dir, &resolved, ck, opts)
 }
@@ -905,7 +1011,8 @@ pub fn resume(dir: &Path, opts: RunOptions) -> Result<Summary, CliError> {
 fn read_summary(dir: &Path) -> Result<Summary, CliError> {
     let p = dir.join(SUMMARY_FILE);
     let text = fs::read_to_string(&p).map_err(|e| io_fail("read", &p, e))?;
-    serde_json::from_str(&text).map_err(|e| CliError::failure(format!("{} is invalid: {e}", p.display())))
+    serde_json::from_str(&text)
+        .map_err(|e| CliError::failure(format!("{} is invalid: {e}", p.display())))
 }
 
 fn progress_bar(total: u64, done: u64, show: bool) -> ProgressBar {
@@ -913,23 +1020,34 @@ fn progress_bar(total: u64, done: u64, show: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new(total);
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} it  {per_sec}  eta {eta}") {
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} it  {per_sec}  eta {eta}")
+    {
         pb.set_style(style);
     }
     pb.set_position(done);
     pb
 }
 
-fn drive(dir: &Path, resolved: &Resolved, mut ck: Checkpoint, opts: RunOptions) -> Result<Summary, CliError> {
+fn drive(
+    dir: &Path,
+    resolved: &Resolved,
+    mut ck: Checkpoint,
+    opts: RunOptions,
+) -> Result<Summary, CliError> {
     let total = resolved.iterations();
     let every = resolved.log_every();
     let partial = dir.join(PARTIAL_LOG_FILE);
-    let mut log = OpenOptions::new().append(true).open(&partial).map_err(|e| io_fail("open", &partial, e))?;
+    let mut log = OpenOptions::new()
+        .append(true)
+        .open(&partial)
+        .map_err(|e| io_fail("open", &partial, e))?;
     let mut solver = PolicySolver::new(&resolved.checked)
         .map_err(|e| CliError::usage(format!("invalid configuration: {e}")))?;
     let mut state = ck.state.clone();
     if state.iteration == 0 {
-        solver.init(&mut state).map_err(|e| CliError::failure(e.to_string()))?;
+        solver
+            .init(&mut state)
+            .map_err(|e| CliError::failure(e.to_string()))?;
     }
     let pb = progress_bar(total, state.iteration, opts.progress);
     let mut chunk = String::new();
@@ -945,12 +1063,12 @@ fn drive(dir: &Path, resolved: &Resolved, mut ck: Checkpoint, opts: RunOptions) 
             }
         };
         tally.add(&record);
-        if record.iteration % every == 0 || state.iteration == total {
+        if record.iteration.is_multiple_of(every) || state.iteration == total {
             chunk.push_str(&log_row(&record));
         }
         pb.set_position(state.iteration);
         let stop = interrupted();
-        if state.iteration % period == 0 || state.iteration == total || stop {
+        if state.iteration.is_multiple_of(period) || state.iteration == total || stop {
             log.write_all(chunk.as_bytes())
                 .and_then(|()| log.sync_data())
                 .map_err(|e| io_fail("write", &partial, e))?;
@@ -982,9 +1100,11 @@ fn drive(dir: &Path, resolved: &Resolved, mut ck: Checkpoint, opts: RunOptions) 
 fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary, CliError> {
     let s = &ck.state;
     let v_star = resolved.v_star();
-    let abs_v_error = v_star
-        .as_ref()
-        .map(|vs| s.v.iter().zip(vs).fold(0.0_f64, |m, (v, vs)| m.max((v - vs).abs())));
+    let abs_v_error = v_star.as_ref().map(|vs| {
+        s.v.iter()
+            .zip(vs)
+            .fold(0.0_f64, |m, (v, vs)| m.max((v - vs).abs()))
+    });
     let wall = ck.elapsed_s;
     let rate = |x: f64| if wall > 0.0 { x / wall } else { 0.0 };
     let summary = Summary {
@@ -992,7 +1112,12 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary, C
         name: resolved.spec.name.clone().unwrap_or_default(),
         sepg_version: VERSION.into(),
         iterations: s.iteration,
-        final_params: FinalParams { v: s.v.clone(), w: s.w.clone(), sigma: s.sigma(), budget: s.budget },
+        final_params: FinalParams {
+            v: s.v.clone(),
+            w: s.w.clone(),
+            sigma: s.sigma(),
+            budget: s.budget,
+        },
         v_star,
         abs_v_error,
         last_j_explore: ck.tally.last_j_explore,
@@ -1028,7 +1153,8 @@ impl Log {
     pub fn read_run(dir: &Path) -> Result<Log, CliError> {
         let done = dir.join(LOG_FILE);
         let bytes = if done.is_file() {
-            fs::read(&done).map_err(|e| CliError::usage(format!("cannot read {}: {e}", done.display())))?
+            fs::read(&done)
+                .map_err(|e| CliError::usage(format!("cannot read {}: {e}", done.display())))?
         } else {
             let partial = dir.join(PARTIAL_LOG_FILE);
             let mut b = fs::read(&partial)
@@ -1037,7 +1163,11 @@ impl Log {
                 .ok()
                 .and_then(|t| serde_json::from_str(&t).ok());
             if let Some(ck) = ck {
-                b.truncate(usize::try_from(ck.log_bytes).unwrap_or(usize::MAX).min(b.len()));
+                b.truncate(
+                    usize::try_from(ck.log_bytes)
+                        .unwrap_or(usize::MAX)
+                        .min(b.len()),
+                );
             }
             b
         };
@@ -1051,7 +1181,11 @@ impl Log {
             .collect();
         let rows = lines
             .filter(|l| l.split(',').count() == columns.len())
-            .map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap_or(f64::NAN)).collect())
+            .map(|l| {
+                l.split(',')
+                    .map(|c| c.parse::<f64>().unwrap_or(f64::NAN))
+                    .collect()
+            })
             .collect();
         Ok(Log { columns, rows })
     }
@@ -1091,17 +1225,34 @@ mod tests {
 
     #[test]
     fn inapplicable_options_are_rejected() {
-        let spec = RunSpec { algo: Some(AlgoName::SepgZv), alpha: Some(0.1), ..RunSpec::default() };
+        let spec = RunSpec {
+            algo: Some(AlgoName::SepgZv),
+            alpha: Some(0.1),
+            ..RunSpec::default()
+        };
         assert!(spec.resolve().is_err());
-        let spec = RunSpec { gradients: Some(GradientsName::Exact), delta: Some(0.1), ..RunSpec::default() };
+        let spec = RunSpec {
+            gradients: Some(GradientsName::Exact),
+            delta: Some(0.1),
+            ..RunSpec::default()
+        };
         assert!(spec.resolve().is_err());
-        let spec = RunSpec { algo: Some(AlgoName::GpomdpConst), ..RunSpec::default() };
+        let spec = RunSpec {
+            algo: Some(AlgoName::GpomdpConst),
+            ..RunSpec::default()
+        };
         assert!(spec.resolve().is_err());
     }
 
     #[test]
     fn header_and_rows_have_the_same_width() {
-        let resolved = RunSpec { iterations: Some(2), batch: Some(12), ..RunSpec::default() }.resolve().expect("valid");
+        let resolved = RunSpec {
+            iterations: Some(2),
+            batch: Some(12),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid");
         let mut solver = PolicySolver::new(&resolved.checked).expect("solver");
         let mut state = resolved.checked.initial_state();
         let r = solver.next_iter(&mut state).expect("iteration");

@@ -144,7 +144,9 @@ pub struct SweepFile {
 impl SweepFile {
     /// The runs of the shard.
     pub fn shard_runs(&self) -> impl Iterator<Item = &RunEntry> {
-        self.runs.iter().filter(|r| r.index % self.shard.count == self.shard.index)
+        self.runs
+            .iter()
+            .filter(|r| r.index % self.shard.count == self.shard.index)
     }
 
     /// Reads `sweep.json` of a sweep folder.
@@ -153,21 +155,27 @@ impl SweepFile {
     /// Usage error when the folder has no valid `sweep.json`.
     pub fn read(dir: &Path) -> Result<SweepFile, CliError> {
         let p = dir.join(SWEEP_FILE);
-        let text = std::fs::read_to_string(&p)
-            .map_err(|e| CliError::usage(format!("{} is not a sweep folder: {e}", dir.display())))?;
-        serde_json::from_str(&text).map_err(|e| CliError::usage(format!("{} is invalid: {e}", p.display())))
+        let text = std::fs::read_to_string(&p).map_err(|e| {
+            CliError::usage(format!("{} is not a sweep folder: {e}", dir.display()))
+        })?;
+        serde_json::from_str(&text)
+            .map_err(|e| CliError::usage(format!("{} is invalid: {e}", p.display())))
     }
 }
 
 fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
 fn path_safe(name: &str) -> bool {
     !name.is_empty()
         && name != "."
         && name != ".."
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
 }
 
 /// Expands a sweep into its resolved runs and `sweep.json` contents (for shard `shard`).
@@ -177,25 +185,41 @@ fn path_safe(name: &str) -> bool {
 /// sets a sweep axis (env, seed, sigma0), or any run whose configuration is invalid.
 pub fn expand(spec: &SweepSpec, shard: Shard) -> Result<(SweepFile, Vec<Resolved>), CliError> {
     let seeds = spec.seeds.list();
-    if spec.presets.is_empty() || seeds.is_empty() || spec.sigma0.is_empty() || spec.variant.is_empty() {
-        return Err(CliError::usage("a sweep needs at least one preset, seed, sigma0 and variant"));
+    if spec.presets.is_empty()
+        || seeds.is_empty()
+        || spec.sigma0.is_empty()
+        || spec.variant.is_empty()
+    {
+        return Err(CliError::usage(
+            "a sweep needs at least one preset, seed, sigma0 and variant",
+        ));
     }
     let axis = |s: &RunSpec| s.env.is_some() || s.seed.is_some() || s.sigma0.is_some();
     if axis(&spec.base) || spec.variant.iter().any(axis) {
-        return Err(CliError::usage("env, seed and sigma0 are sweep axes (presets, seeds, sigma0), not run options"));
+        return Err(CliError::usage(
+            "env, seed and sigma0 are sweep axes (presets, seeds, sigma0), not run options",
+        ));
     }
     let mut names = Vec::new();
     for v in &spec.variant {
         let name = v
             .name
             .clone()
-            .or_else(|| v.algo.and_then(|a| clap::ValueEnum::to_possible_value(&a)).map(|p| p.get_name().to_owned()))
+            .or_else(|| {
+                v.algo
+                    .and_then(|a| clap::ValueEnum::to_possible_value(&a))
+                    .map(|p| p.get_name().to_owned())
+            })
             .ok_or_else(|| CliError::usage("every variant needs a name or an algo"))?;
         if !path_safe(&name) {
-            return Err(CliError::usage(format!("variant name {name:?} must use only letters, digits, '-', '_', '.'")));
+            return Err(CliError::usage(format!(
+                "variant name {name:?} must use only letters, digits, '-', '_', '.'"
+            )));
         }
         if names.contains(&name) {
-            return Err(CliError::usage(format!("variant name {name:?} appears twice")));
+            return Err(CliError::usage(format!(
+                "variant name {name:?} appears twice"
+            )));
         }
         names.push(name);
     }
@@ -213,9 +237,17 @@ pub fn expand(spec: &SweepSpec, shard: Shard) -> Result<(SweepFile, Vec<Resolved
                         seed: Some(seed),
                         ..RunSpec::default()
                     };
-                    let r = spec.base.overlay(variant).overlay(&axes).resolve().map_err(|e| {
-                        CliError::usage(format!("variant {name} on {} with sigma0 {sigma0}: {e}", preset.name()))
-                    })?;
+                    let r = spec
+                        .base
+                        .overlay(variant)
+                        .overlay(&axes)
+                        .resolve()
+                        .map_err(|e| {
+                            CliError::usage(format!(
+                                "variant {name} on {} with sigma0 {sigma0}: {e}",
+                                preset.name()
+                            ))
+                        })?;
                     hash_input.push_str(&r.toml()?);
                     runs.push(RunEntry {
                         index: runs.len(),
@@ -223,7 +255,10 @@ pub fn expand(spec: &SweepSpec, shard: Shard) -> Result<(SweepFile, Vec<Resolved
                         variant: name.clone(),
                         sigma0,
                         seed,
-                        dir: format!("{RUNS_DIR}/{}/{name}/sigma-{sigma0:?}/seed-{seed}", preset.name()),
+                        dir: format!(
+                            "{RUNS_DIR}/{}/{name}/sigma-{sigma0:?}/seed-{seed}",
+                            preset.name()
+                        ),
                     });
                     resolved.push(r);
                 }
@@ -262,7 +297,8 @@ pub fn parse_shard(s: &str) -> Result<Shard, CliError> {
 pub fn read_spec(path: &Path) -> Result<SweepSpec, CliError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::usage(format!("cannot read {}: {e}", path.display())))?;
-    toml::from_str(&text).map_err(|e| CliError::usage(format!("{}: {}", path.display(), runfmt::toml_message(&e))))
+    toml::from_str(&text)
+        .map_err(|e| CliError::usage(format!("{}: {}", path.display(), runfmt::toml_message(&e))))
 }
 
 /// Throughput of a finished sweep.
@@ -289,8 +325,11 @@ pub fn execute(
     progress: bool,
 ) -> Result<SweepStats, CliError> {
     runfmt::install_interrupt_handler();
-    let todo: Vec<(&RunEntry, &Resolved)> =
-        file.shard_runs().map(|r| (r, &resolved[r.index])).filter(|(r, _)| !runfmt::is_complete(&dir.join(&r.dir))).collect();
+    let todo: Vec<(&RunEntry, &Resolved)> = file
+        .shard_runs()
+        .map(|r| (r, &resolved[r.index]))
+        .filter(|(r, _)| !runfmt::is_complete(&dir.join(&r.dir)))
+        .collect();
     let total: u64 = todo.iter().map(|(_, r)| r.iterations()).sum();
     let pb = if progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         let pb = ProgressBar::new(todo.len() as u64);
@@ -301,7 +340,10 @@ pub fn execute(
     } else {
         ProgressBar::hidden()
     };
-    let opts = RunOptions { checkpoint_every, progress: false };
+    let opts = RunOptions {
+        checkpoint_every,
+        progress: false,
+    };
     let start = Instant::now();
     let results: Vec<Result<(), CliError>> = todo
         .par_iter()
@@ -320,7 +362,11 @@ pub fn execute(
     if let Some(Err(e)) = results.into_iter().find(Result::is_err) {
         return Err(e);
     }
-    Ok(SweepStats { runs: todo.len(), iterations: total, wall_s: start.elapsed().as_secs_f64() })
+    Ok(SweepStats {
+        runs: todo.len(),
+        iterations: total,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// Creates the sweep folder `dir` with `sweep.json` and runs it.
@@ -336,15 +382,24 @@ pub fn start(
     progress: bool,
 ) -> Result<SweepStats, CliError> {
     runfmt::check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR])?;
-    std::fs::create_dir_all(dir).map_err(|e| CliError::failure(format!("cannot create {}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::failure(format!("cannot create {}: {e}", dir.display())))?;
     write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())?;
     execute(dir, file, resolved, checkpoint_every, progress)
 }
 
 /// The one-line report of a finished sweep.
 pub fn stats_line(dir: &Path, file: &SweepFile, s: &SweepStats) -> String {
-    let shard = if file.shard.count > 1 { format!(" (shard {}/{})", file.shard.index, file.shard.count) } else { String::new() };
-    let rate = if s.wall_s > 0.0 { s.iterations as f64 / s.wall_s } else { 0.0 };
+    let shard = if file.shard.count > 1 {
+        format!(" (shard {}/{})", file.shard.index, file.shard.count)
+    } else {
+        String::new()
+    };
+    let rate = if s.wall_s > 0.0 {
+        s.iterations as f64 / s.wall_s
+    } else {
+        0.0
+    };
     format!(
         "{}{shard}: {} runs, {} iterations in {:.1} s ({:.0} it/s)",
         dir.display(),
@@ -365,7 +420,9 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     }
     let (dir, file, stats) = if let Some(dir) = &args.resume {
         if args.config.is_some() || args.out.is_some() || args.shard.is_some() || args.force {
-            return Err(CliError::usage("--resume takes no other options than --quiet and --checkpoint-every"));
+            return Err(CliError::usage(
+                "--resume takes no other options than --quiet and --checkpoint-every",
+            ));
         }
         let file = SweepFile::read(dir)?;
         let (expected, resolved) = expand(&file.spec, file.shard)?;
@@ -378,15 +435,28 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         let stats = execute(dir, &file, &resolved, args.checkpoint_every, !args.quiet)?;
         (dir.clone(), file, stats)
     } else {
-        let path = args.config.as_ref().ok_or_else(|| CliError::usage("--config FILE.toml is required"))?;
+        let path = args
+            .config
+            .as_ref()
+            .ok_or_else(|| CliError::usage("--config FILE.toml is required"))?;
         let spec = read_spec(path)?;
         let shard = match &args.shard {
             Some(s) => parse_shard(s)?,
             None => Shard { index: 0, count: 1 },
         };
         let (file, resolved) = expand(&spec, shard)?;
-        let dir = args.out.clone().ok_or_else(|| CliError::usage("--out DIR is required"))?;
-        let stats = start(&dir, &file, &resolved, args.force, args.checkpoint_every, !args.quiet)?;
+        let dir = args
+            .out
+            .clone()
+            .ok_or_else(|| CliError::usage("--out DIR is required"))?;
+        let stats = start(
+            &dir,
+            &file,
+            &resolved,
+            args.force,
+            args.checkpoint_every,
+            !args.quiet,
+        )?;
         (dir, file, stats)
     };
     if !args.quiet {

@@ -37,7 +37,10 @@ pub struct VerifyArgs {
 fn outcome_text(r: &CheckResult) -> String {
     match &r.outcome {
         Outcome::Holds { max_error } => format!("holds (max error {})", fmt_f64(*max_error)),
-        Outcome::HoldsWithMargin { margin, relative_margin } => format!(
+        Outcome::HoldsWithMargin {
+            margin,
+            relative_margin,
+        } => format!(
             "holds with margin {} (relative {})",
             fmt_f64(*margin),
             fmt_f64(*relative_margin)
@@ -48,11 +51,22 @@ fn outcome_text(r: &CheckResult) -> String {
 }
 
 fn summary(report: &Report) -> String {
-    let width = report.results.iter().map(|r| r.meta.id.len()).max().unwrap_or(2).max(2);
+    let width = report
+        .results
+        .iter()
+        .map(|r| r.meta.id.len())
+        .max()
+        .unwrap_or(2)
+        .max(2);
     let mut out = String::new();
     for r in &report.results {
         let mark = if r.as_expected { "ok" } else { "CHANGED" };
-        out.push_str(&format!("{:<7} {:<width$}  {}\n", mark, r.meta.id, outcome_text(r)));
+        out.push_str(&format!(
+            "{:<7} {:<width$}  {}\n",
+            mark,
+            r.meta.id,
+            outcome_text(r)
+        ));
     }
     let changed = report.results.iter().filter(|r| !r.as_expected).count();
     out.push_str(&format!(
@@ -68,7 +82,10 @@ fn summary(report: &Report) -> String {
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let checks = registry();
     let filter = args.check.as_deref();
-    let selected = checks.iter().filter(|c| filter.is_none_or(|f| c.meta.id.contains(f))).count();
+    let selected = checks
+        .iter()
+        .filter(|c| filter.is_none_or(|f| c.meta.id.contains(f)))
+        .count();
     if selected == 0 {
         return Err(CliError::usage(format!(
             "no check matches '{}' (see `sepg verify --json` for the identifiers)",
@@ -84,7 +101,10 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     } else {
         ProgressBar::hidden()
     };
-    let config = RunConfig { seed: args.seed, quick: args.quick };
+    let config = RunConfig {
+        seed: args.seed,
+        quick: args.quick,
+    };
     let report = run_checks(&checks, &config, filter, |r| {
         bar.set_message(r.meta.id.clone());
         bar.inc(1);
@@ -103,7 +123,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     } else {
         print!("{}", summary(&report));
     }
-    let changed: Vec<&str> = report.unexpected().iter().map(|r| r.meta.id.as_str()).collect();
+    let changed: Vec<&str> = report
+        .unexpected()
+        .iter()
+        .map(|r| r.meta.id.as_str())
+        .collect();
     if changed.is_empty() {
         Ok(())
     } else {

@@ -2,9 +2,10 @@
 //!
 //! Every numbered statement of the thesis's Chapters 3–4 and Appendices A–B gets one or more
 //! [`Check`]s. A check states its claim, its ground truth (exact finite-MDP evaluation, closed
-//! forms, numeric integration, exact arithmetic), how configurations are drawn (proptest
-//! strategies, with edge cases), its tolerance and false-alarm rate, and the outcome expected
-//! from measurement. [`run_checks`] runs a selection in parallel and returns a [`Report`] whose
+//! forms, numeric integration, exact arithmetic, the exact J of the clipped LQG presets by
+//! dynamic programming, Monte Carlo with exact binomial or z tests), how configurations are
+//! drawn (proptest strategies, with edge cases), its tolerance and false-alarm rate, and the
+//! outcome expected from measurement. [`run_checks`] runs a selection in parallel and returns a [`Report`] whose
 //! Markdown and JSON forms are byte-identical for the same seed and version, whatever the
 //! number of threads.
 //!

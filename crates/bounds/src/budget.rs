@@ -42,6 +42,9 @@ impl Budget {
     /// A budget starting at B⁰ = `initial` with starting performances J_E⁰ and (optionally)
     /// J_T⁰ of the target policy (Algorithm 4.3, lines 2–3).
     ///
+    /// Errors: an input not finite; [`BoundsError::Overflow`] if the baseline or another
+    /// reported quantity overflows (performances near ±f64::MAX).
+    ///
     /// ```
     /// use sepg_bounds::budget::Budget;
     /// let b = Budget::new(1.0, -10.0, Some(-8.0))?;
@@ -59,13 +62,35 @@ impl Budget {
             Some(t) => Some((finite("J_T", t)?, t)),
             None => None,
         };
-        Ok(Self {
+        Self {
             initial,
             value: initial,
             exploratory_start: j_exploratory,
             exploratory: j_exploratory,
             target,
-        })
+        }
+        .checked()
+    }
+
+    /// `self` if every quantity the budget reports is finite: finite performances near
+    /// ±f64::MAX can still overflow in the sums behind [`Self::baseline`],
+    /// [`Self::average_performance`], [`Self::telescoped_change`] and
+    /// [`Self::guaranteed_average`]. Every constructor and update goes through it, so a
+    /// budget never holds a state whose reported values are not finite.
+    fn checked(self) -> Result<Self, BoundsError> {
+        let reported = [
+            self.baseline(),
+            self.average_performance(),
+            self.telescoped_change(),
+            self.guaranteed_average(),
+        ];
+        if reported.iter().all(|x| x.is_finite()) {
+            Ok(self)
+        } else {
+            Err(BoundsError::Overflow {
+                quantity: "budget baseline, average or change",
+            })
+        }
     }
 
     /// Adds a measured difference ΔJ_E = J(θ_E') − J(θ_E) (v- or w-budget update,
@@ -76,6 +101,9 @@ impl Budget {
     /// ```text
     /// B ← B + ΔJ_E,   J_E ← J_E + ΔJ_E
     /// ```
+    ///
+    /// Errors: ΔJ_E not finite; [`BoundsError::Overflow`] (budget unchanged) if the budget or
+    /// a reported quantity would overflow.
     ///
     /// ```
     /// use sepg_bounds::budget::Budget;
@@ -88,8 +116,12 @@ impl Budget {
         finite("delta J_E", delta)?;
         let value = no_overflow("budget", self.value + delta)?;
         let exploratory = no_overflow("J_E", self.exploratory + delta)?;
-        self.value = value;
-        self.exploratory = exploratory;
+        *self = Self {
+            value,
+            exploratory,
+            ..self.clone()
+        }
+        .checked()?;
         Ok(())
     }
 
@@ -101,7 +133,8 @@ impl Budget {
     /// B ← B + ΔJ_T,   J_T ← J_T + ΔJ_T
     /// ```
     ///
-    /// Errors: [`BoundsError::NoTargetPolicy`] if the budget tracks no target.
+    /// Errors: [`BoundsError::NoTargetPolicy`] if the budget tracks no target;
+    /// [`BoundsError::Overflow`] (budget unchanged) if a reported quantity would overflow.
     ///
     /// ```
     /// use sepg_bounds::budget::Budget;
@@ -116,8 +149,12 @@ impl Budget {
         let (start, current) = self.target.ok_or(BoundsError::NoTargetPolicy)?;
         let value = no_overflow("budget", self.value + delta)?;
         let target = no_overflow("J_T", current + delta)?;
-        self.value = value;
-        self.target = Some((start, target));
+        *self = Self {
+            value,
+            target: Some((start, target)),
+            ..self.clone()
+        }
+        .checked()?;
         Ok(())
     }
 
@@ -139,8 +176,10 @@ impl Budget {
     pub fn record_exploratory(&mut self, j: f64) -> Result<f64, BoundsError> {
         finite("J_E", j)?;
         let delta = no_overflow("delta J_E", j - self.exploratory)?;
-        self.add_exploratory_difference(delta)?;
-        self.exploratory = j;
+        let mut next = self.clone();
+        next.add_exploratory_difference(delta)?;
+        next.exploratory = j;
+        *self = next.checked()?;
         Ok(delta)
     }
 
@@ -162,8 +201,10 @@ impl Budget {
         finite("J_T", j)?;
         let (start, current) = self.target.ok_or(BoundsError::NoTargetPolicy)?;
         let delta = no_overflow("delta J_T", j - current)?;
-        self.add_target_difference(delta)?;
-        self.target = Some((start, j));
+        let mut next = self.clone();
+        next.add_target_difference(delta)?;
+        next.target = Some((start, j));
+        *self = next.checked()?;
         Ok(delta)
     }
 

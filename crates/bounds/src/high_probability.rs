@@ -183,23 +183,35 @@ impl HighProbabilityBound {
         } else {
             -1.0
         };
-        Ok(Some(Self {
+        Self {
             direction,
             linear_lower: no_overflow("L- J-", nl.lower * nj.lower)?,
             linear_upper: no_overflow("L+ J+", nl.upper * nj.upper)?,
             quadratic: no_overflow("d (L+)^2", dd * nl.upper * nl.upper)?,
-        }))
+        }
+        .representable()
+        .map(Some)
     }
 
     /// The bound with squared corrected norms (Theorems 4.7 and 4.8) and penalty `k`.
     fn squared(n: CorrectedNorm, k: f64) -> Result<Self, BoundsError> {
         let up2 = no_overflow("(||grad||+)^2", n.upper * n.upper)?;
-        Ok(Self {
+        Self {
             direction: 1.0,
             linear_lower: n.lower * n.lower,
             linear_upper: up2,
             quadratic: no_overflow("bound quadratic coefficient", k * up2)?,
-        })
+        }
+        .representable()
+    }
+
+    /// Checks that the vertex and C_max are finite: with tiny task constants or estimates the
+    /// quadratic coefficient b can underflow to 0 (or a⁻/(2b) overflow) although the exact
+    /// values are positive, which would make [`Self::vertex`] and [`Self::c_max`] NaN or ∞.
+    fn representable(self) -> Result<Self, BoundsError> {
+        no_overflow("step-size vertex", self.vertex())?;
+        no_overflow("C_max", self.c_max())?;
+        Ok(self)
     }
 
     /// The thesis-form bound at the signed step x (valid for s·x ≥ 0).

@@ -182,6 +182,9 @@ pub(crate) fn solve_quadratic(a: f64, b: f64, required: f64) -> Result<StepOutco
     } else {
         (-half, half)
     };
+    // lo ≤ vertex ≤ hi exactly; the quotient C/(b·x) can land an ulp past the vertex when
+    // C = C_max, and many ulps when C_max is subnormal.
+    let (lo, hi) = (lo.min(vertex), hi.max(vertex));
     let lambda = (c_max > 0.0).then(|| (1.0 - required / c_max).max(0.0).sqrt());
     Ok(StepOutcome::Feasible(SafeInterval {
         c_max,

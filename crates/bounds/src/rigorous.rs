@@ -55,6 +55,8 @@ const MAX_BISECTIONS: usize = 2200;
 ///
 /// Computed by its Taylor series for small |Δw| so that it keeps full relative accuracy.
 ///
+/// Errors: Δw not finite; [`BoundsError::Overflow`] when 2|Δw| overflows (|Δw| > f64::MAX / 2).
+///
 /// ```
 /// use sepg_bounds::rigorous::kl2;
 /// let x: f64 = 0.3;
@@ -65,7 +67,7 @@ const MAX_BISECTIONS: usize = 2200;
 /// ```
 pub fn kl2(delta_w: f64) -> Result<f64, BoundsError> {
     finite("delta_w", delta_w)?;
-    Ok(kl2_unchecked(delta_w))
+    no_overflow("KL2", kl2_unchecked(delta_w))
 }
 
 /// e^{−y} − 1 + y for y = 2|Δw| ≥ 0: alternating Taylor series below 0.1 (no cancellation),

@@ -16,6 +16,27 @@ use crate::quantile::student_t_quantile;
 pub enum Width {
     /// Student-t interval (Sec 4.5): `ε_i = t(1 − δ/2, N − 1) · √(Var_i / N)`.
     StudentT,
+    /// Student-t interval corrected for the skewness of the samples by Hall's (1992) cubic
+    /// transformation of the studentised mean. The CLT interval under-covers on skewed
+    /// per-trajectory samples (Sec 4.5 notes it is asymptotic); the correction shifts both
+    /// ends by about `(μ̂₃/Var)(1 + 2t²)/(6N)` in the direction of the skew, removing the
+    /// `O(N^{-1/2})` coverage error of a skewed population.
+    ///
+    /// The interval is asymmetric: [`Estimate::intervals_into`] gives its ends, and the widths
+    /// ([`Estimate::widths_into`], [`Estimate::confidence`]) are the half-width of the
+    /// smallest interval centred on the estimate that contains it. It needs the third moment
+    /// of the samples, so the free function [`width`] rejects it.
+    ///
+    /// # Formula
+    /// ```text
+    /// s = √Var,  γ̂ = (1/N) Σ_i ((x_i − x̄)/s)³,  b = γ̂/(6N),  y = t(1 − δ/2, N − 1)/√N
+    /// g(T) = T + γ̂T²/3 + γ̂²T³/27 + b                    (increasing in T = (x̄ − μ)/s)
+    /// g⁻¹(y) = 3(y − b) / (c² + c + 1),  c = ∛(1 + γ̂(y − b))
+    /// interval: [x̄ − s g⁻¹(y), x̄ − s g⁻¹(−y)],   ε = s · max(g⁻¹(y), −g⁻¹(−y))
+    /// ```
+    /// With `γ̂ = 0` it is the Student-t interval. Reference: P. Hall, "On the removal of
+    /// skewness by transformation", J. R. Statist. Soc. B 54 (1992) 221–228.
+    SkewCorrectedT,
     /// Chebyshev's inequality with the sample variance: `ε_i = √(Var_i / (N δ))`.
     Chebyshev,
     /// Hoeffding's inequality for samples in an interval of length `range`:
@@ -38,6 +59,7 @@ pub enum Width {
 /// # Formula
 /// ```text
 /// StudentT:           ε = t(1 − δ/2, n − 1) · √(Var / n)
+/// SkewCorrectedT:     needs the samples, see Estimate::widths_into
 /// Chebyshev:          ε = √(Var / (n δ))
 /// Hoeffding:          ε = range · √(ln(2/δ) / (2n))
 /// EmpiricalBernstein: ε = √(2 Var ln(4/δ) / n) + 7 range ln(4/δ) / (3(n − 1))
@@ -48,7 +70,8 @@ pub enum Width {
 /// # Errors
 /// [`EstimatorError::TooFewTrajectories`] if `n < 2`; [`EstimatorError::InvalidDelta`] unless
 /// `0 < δ < 1`; [`EstimatorError::NonFinite`] if `variance` is negative or not finite;
-/// [`EstimatorError::InvalidRange`] for a range that is not finite and positive.
+/// [`EstimatorError::InvalidRange`] for a range that is not finite and positive;
+/// [`EstimatorError::NeedsSamples`] for [`Width::SkewCorrectedT`].
 ///
 /// # Examples
 /// ```
@@ -56,11 +79,17 @@ pub enum Width {
 /// // Chebyshev with Var = 4, n = 100, δ = 0.04: √(4 / 4) = 1.
 /// assert_eq!(width(Width::Chebyshev, 4.0, 100, 0.04)?, 1.0);
 /// assert!(width(Width::StudentT, 4.0, 100, 1.5).is_err());
+/// assert!(width(Width::SkewCorrectedT, 4.0, 100, 0.05).is_err());
 /// # Ok::<(), sepg_estimators::EstimatorError>(())
 /// ```
 pub fn width(method: Width, variance: f64, n: usize, delta: f64) -> Result<f64, EstimatorError> {
     if !(variance >= 0.0 && variance.is_finite()) {
         return Err(EstimatorError::NonFinite { what: "variance" });
+    }
+    if method == Width::SkewCorrectedT {
+        return Err(EstimatorError::NeedsSamples {
+            method: "skew-corrected Student-t",
+        });
     }
     Ok(Factors::new(method, n, delta)?.width(variance))
 }
@@ -90,7 +119,7 @@ impl Factors {
             }
         };
         Ok(match method {
-            Width::StudentT => Factors {
+            Width::StudentT | Width::SkewCorrectedT => Factors {
                 scale: cached_t_quantile(1.0 - 0.5 * delta, nf - 1.0)? / nf.sqrt(),
                 offset: 0.0,
             },
@@ -115,6 +144,17 @@ impl Factors {
     fn width(&self, variance: f64) -> f64 {
         self.scale * variance.sqrt() + self.offset
     }
+}
+
+/// Ends of Hall's skew-corrected interval relative to the estimate, `(lo, hi)` with
+/// `lo ≤ 0 ≤ hi` (see [`Width::SkewCorrectedT`]); `y = t/√n`, `s = √Var`, `gamma = γ̂`.
+fn hall_offsets(y: f64, s: f64, gamma: f64, n: f64) -> (f64, f64) {
+    let b = gamma / (6.0 * n);
+    let g_inv = |y: f64| {
+        let c = (1.0 + gamma * (y - b)).cbrt();
+        3.0 * (y - b) / (c * c + c + 1.0)
+    };
+    (-s * g_inv(y), -s * g_inv(-y))
 }
 
 thread_local! {
@@ -221,11 +261,87 @@ impl Estimate {
         }
         let f = Factors::new(method, self.n(), delta)?;
         let mut eps = 0.0f64;
-        for (o, v) in out.iter_mut().zip(self.variance()) {
-            *o = f.width(*v);
+        for (k, (o, v)) in out.iter_mut().zip(self.variance()).enumerate() {
+            *o = if method == Width::SkewCorrectedT {
+                let (lo, hi) = self.hall(f.scale, k);
+                hi.max(-lo)
+            } else {
+                f.width(*v)
+            };
             eps = eps.max(*o);
         }
         Ok(eps)
+    }
+
+    /// Writes the confidence interval `[lower_i, upper_i]` of every component (Sec 4.5):
+    /// `mean_i ∓ ε_i` for the symmetric methods, the asymmetric ends of Hall's interval for
+    /// [`Width::SkewCorrectedT`].
+    ///
+    /// # Formula
+    /// ```text
+    /// symmetric:        [mean_i − ε_i, mean_i + ε_i]       (ε_i of `width`)
+    /// SkewCorrectedT:   [mean_i − s_i g⁻¹(y), mean_i − s_i g⁻¹(−y)]
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Estimate::widths_into`], for either buffer.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_estimators::{Estimate, Estimator, Width};
+    /// use sepg_mdp::Batch;
+    /// // Right-skewed returns: the corrected interval is shifted up.
+    /// let mut batch = Batch::zeros(6, 1, 1, 1, 0.9);
+    /// batch.disc_rewards.copy_from_slice(&[0.0, 0.1, 0.0, 0.2, 0.1, 3.0]);
+    /// let mut est = Estimate::new();
+    /// Estimator::new().value(&batch, &mut est)?;
+    /// let (mut lo, mut hi) = ([0.0], [0.0]);
+    /// est.intervals_into(Width::SkewCorrectedT, 0.1, &mut lo, &mut hi)?;
+    /// let mean = est.mean()[0];
+    /// assert!(hi[0] - mean > mean - lo[0]);
+    /// est.intervals_into(Width::StudentT, 0.1, &mut lo, &mut hi)?;
+    /// assert!((hi[0] - mean - (mean - lo[0])).abs() < 1e-15);
+    /// # Ok::<(), sepg_estimators::EstimatorError>(())
+    /// ```
+    pub fn intervals_into(
+        &self,
+        method: Width,
+        delta: f64,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<(), EstimatorError> {
+        for buffer in [&*lower, &*upper] {
+            if buffer.len() != self.dim() {
+                return Err(EstimatorError::DimensionMismatch {
+                    what: "interval buffer",
+                    expected: self.dim(),
+                    found: buffer.len(),
+                });
+            }
+        }
+        let f = Factors::new(method, self.n(), delta)?;
+        let parts = lower.iter_mut().zip(upper.iter_mut());
+        for (k, ((lo, hi), (m, v))) in parts
+            .zip(self.mean().iter().zip(self.variance()))
+            .enumerate()
+        {
+            let (dlo, dhi) = if method == Width::SkewCorrectedT {
+                self.hall(f.scale, k)
+            } else {
+                let e = f.width(*v);
+                (-e, e)
+            };
+            *lo = m + dlo;
+            *hi = m + dhi;
+        }
+        Ok(())
+    }
+
+    /// Hall's interval ends of component `k` relative to the estimate, for `y = t/√n`.
+    fn hall(&self, y: f64, k: usize) -> (f64, f64) {
+        let s = self.variance()[k].sqrt();
+        let gamma = self.standardized_third_moment(k);
+        hall_offsets(y, s, gamma, self.n() as f64)
     }
 
     /// The corrected norms of Sec 4.5 for this estimate: `‖∇̂‖∞` and `ε = max_i ε_i`
@@ -254,10 +370,16 @@ impl Estimate {
     /// ```
     pub fn confidence(&self, method: Width, delta: f64) -> Result<Confidence, EstimatorError> {
         let f = Factors::new(method, self.n(), delta)?;
-        let eps = self
-            .variance()
-            .iter()
-            .fold(0.0f64, |e, v| e.max(f.width(*v)));
+        let eps = if method == Width::SkewCorrectedT {
+            (0..self.dim()).fold(0.0f64, |e, k| {
+                let (lo, hi) = self.hall(f.scale, k);
+                e.max(hi).max(-lo)
+            })
+        } else {
+            self.variance()
+                .iter()
+                .fold(0.0f64, |e, v| e.max(f.width(*v)))
+        };
         Ok(Confidence {
             norm_inf: self.norm_inf(),
             eps,

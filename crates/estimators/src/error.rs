@@ -68,6 +68,13 @@ pub enum EstimatorError {
         /// The offending value.
         value: f64,
     },
+    /// The confidence width needs the per-trajectory samples (e.g. their third moment), not
+    /// only the variance: use the methods of [`crate::Estimate`].
+    #[error("the {method} width needs the samples: use Estimate::widths_into")]
+    NeedsSamples {
+        /// The width method.
+        method: &'static str,
+    },
     /// A closed form of `sepg_bounds` (e.g. `c(σ)`) could not be evaluated.
     #[error(transparent)]
     Bounds(#[from] sepg_bounds::BoundsError),

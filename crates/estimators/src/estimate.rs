@@ -130,6 +130,29 @@ impl Estimate {
         self.mean.iter().fold(0.0, |m, x| m.max(x.abs()))
     }
 
+    /// Sample skewness of component `k`, `γ̂_k = (1/n) Σ_i ((x_{i,k} − x̄_k)/s_k)³` with
+    /// `s_k = √variance_k` (0 when `s_k = 0`). Standardising before cubing keeps every term
+    /// below `n^{3/2}` in magnitude, so no overflow (and dividing, rather than multiplying by
+    /// `1/s_k`, keeps a subnormal `s_k` finite).
+    pub(crate) fn standardized_third_moment(&self, k: usize) -> f64 {
+        let s = self.variance[k].sqrt();
+        if s <= 0.0 {
+            return 0.0;
+        }
+        let c = self.centre[k];
+        let sum: f64 = self
+            .samples
+            .iter()
+            .skip(k)
+            .step_by(self.dim)
+            .map(|x| {
+                let z = (x - c) / s;
+                z * z * z
+            })
+            .sum();
+        sum / self.n as f64
+    }
+
     /// Resizes the buffers to `n × dim` (no allocation when the capacity suffices) and returns
     /// the sample buffer to fill.
     pub(crate) fn reset(&mut self, n: usize, dim: usize) -> &mut [f64] {

@@ -414,8 +414,14 @@ impl Estimator {
         let nr = rows.len();
         let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
         let scores = |p: Param| match p {
-            Param::V => (&batch.cum_score_v[rows.start * h * batch.dim_v..], batch.dim_v),
-            Param::W => (&batch.cum_score_w[rows.start * h * batch.dim_w..], batch.dim_w),
+            Param::V => (
+                &batch.cum_score_v[rows.start * h * batch.dim_v..],
+                batch.dim_v,
+            ),
+            Param::W => (
+                &batch.cum_score_w[rows.start * h * batch.dim_w..],
+                batch.dim_w,
+            ),
         };
         match target {
             Target::Gpomdp(p) | Target::Pgt(p) => {
@@ -424,14 +430,34 @@ impl Estimator {
                 let s = Rows::new(s, w);
                 let f = broadcast(&mut self.bcast, rewards, h, comps);
                 if let Target::Pgt(_) = target {
-                    run_score(&mut self.sums, s, f, nr, w, comps, baseline, fit, Output::Baselines);
+                    run_score(
+                        &mut self.sums,
+                        s,
+                        f,
+                        nr,
+                        w,
+                        comps,
+                        baseline,
+                        fit,
+                        Output::Baselines,
+                    );
                     let base = self.sums.baselines(w);
                     let f = Rows::new(rewards, h);
                     for (r, x) in out[..nr * comps].chunks_exact_mut(comps).enumerate() {
                         pgt_sample(s.row(r, w), f.row(r, h), base.row(r, w), x);
                     }
                 } else {
-                    run_score(&mut self.sums, s, f, nr, w, comps, baseline, fit, Output::Sums(out));
+                    run_score(
+                        &mut self.sums,
+                        s,
+                        f,
+                        nr,
+                        w,
+                        comps,
+                        baseline,
+                        fit,
+                        Output::Sums(out),
+                    );
                 }
             }
             Target::Reinforce(p) => {
@@ -440,7 +466,17 @@ impl Estimator {
                 returns_into(batch, rows, &mut self.returns);
                 let s = Rows::new(&s[(h - 1) * comps..], h * comps);
                 let f = broadcast(&mut self.bcast, &self.returns, 1, comps);
-                run_score(&mut self.sums, s, f, nr, comps, comps, baseline, fit, Output::Sums(out));
+                run_score(
+                    &mut self.sums,
+                    s,
+                    f,
+                    nr,
+                    comps,
+                    comps,
+                    baseline,
+                    fit,
+                    Output::Sums(out),
+                );
             }
             Target::H => {
                 self.fill_h(batch, rows, baseline);
@@ -538,11 +574,9 @@ fn run_score(
 ) {
     let inputs = [s, f];
     if baseline == Baseline::Optimal {
-        sums
-            .run::<2, Score<true>>(inputs, rows, width, comps, baseline, fit, output);
+        sums.run::<2, Score<true>>(inputs, rows, width, comps, baseline, fit, output);
     } else {
-        sums
-            .run::<2, Score<false>>(inputs, rows, width, comps, baseline, fit, output);
+        sums.run::<2, Score<false>>(inputs, rows, width, comps, baseline, fit, output);
     }
 }
 

@@ -121,8 +121,8 @@ impl Formula<3> for HMean {
 pub(crate) enum Output<'a> {
     /// `x_{r,c} = Σ_t p(v_{r,t,c}; b_{t,c})` into `rows × comps` samples.
     Sums(&'a mut [f64]),
-    /// The baselines themselves, `rows × width`, for a sample of another order (PGT), as
-    /// `(buffer, stride)` via [`Sums::baselines`].
+    /// Keep the baselines themselves, for a sample of another order (PGT); read them with
+    /// [`Sums::baselines`].
     Baselines,
 }
 
@@ -186,7 +186,8 @@ impl Sums {
                 zeroed(&mut self.pre_den, w);
                 for r in 0..rows {
                     let v = row(r);
-                    for (e, (pn, pd)) in self.pre_num.iter_mut().zip(&mut self.pre_den).enumerate() {
+                    for (e, (pn, pd)) in self.pre_num.iter_mut().zip(&mut self.pre_den).enumerate()
+                    {
                         let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
                         *pn += n;
                         *pd += d;
@@ -247,7 +248,10 @@ impl Sums {
             if comps == 1 {
                 row_sums(&mut out[..rows], w, 0.0, [Rows::new(terms, w)], |[p]| p);
             } else {
-                for (x, p) in out[..rows * comps].chunks_exact_mut(comps).zip(terms.chunks_exact(w)) {
+                for (x, p) in out[..rows * comps]
+                    .chunks_exact_mut(comps)
+                    .zip(terms.chunks_exact(w))
+                {
                     x.fill(0.0);
                     for pt in p.chunks_exact(comps) {
                         for (xc, pc) in x.iter_mut().zip(pt) {
@@ -282,6 +286,10 @@ fn ratio(num: f64, den: f64) -> f64 {
 /// row `r`, four rows at a time (independent dependency chains; the result does not depend on
 /// the blocking).
 #[inline(always)]
+#[expect(
+    clippy::needless_range_loop,
+    reason = "`t` indexes the same column of several rows"
+)]
 pub(crate) fn row_sums<const A: usize>(
     out: &mut [f64],
     len: usize,

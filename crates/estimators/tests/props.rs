@@ -80,8 +80,111 @@ fn check_all(b: &Batch, allow_overflow: bool) -> Result<(), TestCaseError> {
     ok(r, &out)
 }
 
+/// Naive reference of every baseline-fitted estimator: for each trajectory `i` and entry
+/// `(t, c)`, the baseline is summed directly over the fitting set (all trajectories, or all
+/// but `i`) and the sample is `Σ_t p(entry; b)`; returns `n × comps` samples.
+fn naive(b: &Batch, target: &str, baseline: Baseline, fit: BaselineFit) -> Vec<f64> {
+    let (n, h, m, l) = (b.n, b.horizon, b.dim_v, b.dim_w);
+    // Entries (num, den, p(b) = a − b·z) of trajectory i: (steps, comps, closure).
+    let entry = |i: usize, t: usize, c: usize| -> (f64, f64, f64, f64) {
+        let f = b.disc_rewards[i * h + t];
+        let opt = baseline == Baseline::Optimal;
+        let score = |s: f64, f: f64| {
+            let (num, den) = if opt { (s * s * f, s * s) } else { (f, 1.0) };
+            (num, den, s * f, s)
+        };
+        match target {
+            "v" => score(b.cum_score_v[(i * h + t) * m + c], f),
+            "w" => score(b.cum_score_w[(i * h + t) * l + c], f),
+            "reinforce" => {
+                let ret: f64 = b.disc_rewards[i * h..(i + 1) * h].iter().sum();
+                score(b.cum_score_v[(i * h + h - 1) * m + c], ret)
+            }
+            _ => {
+                let (j, k) = (c / m, c % m);
+                let g = b.cum_score_v[(i * h + t) * m + k];
+                let hs = b.cum_score_w[(i * h + t) * l + j] / b.sigma[j];
+                let u = g * hs * f;
+                if opt {
+                    let z = g + hs;
+                    (u * z, z * z, u, z)
+                } else {
+                    (f, 1.0, u, g * hs)
+                }
+            }
+        }
+    };
+    let (steps, comps) = match target {
+        "v" => (h, m),
+        "w" => (h, l),
+        "reinforce" => (1, m),
+        _ => (h, l * m),
+    };
+    let mut out = vec![0.0; n * comps];
+    for i in 0..n {
+        for t in 0..steps {
+            for c in 0..comps {
+                let (mut num, mut den) = (0.0, 0.0);
+                for r in (0..n).filter(|&r| fit == BaselineFit::PlugIn || r != i) {
+                    let (a, d, _, _) = entry(r, t, c);
+                    num += a;
+                    den += d;
+                }
+                let base = match baseline {
+                    Baseline::None => 0.0,
+                    _ if den > 0.0 => num / den,
+                    _ => 0.0,
+                };
+                let (_, _, a, z) = entry(i, t, c);
+                out[i * comps + c] += a - base * z;
+            }
+        }
+    }
+    out
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn baselines_match_naive_reference(
+        n in 2usize..7, h in 1usize..5, p in 1usize..3, l in 1usize..3,
+        values in prop::collection::vec(-10f64..10.0, 1..64),
+        zeros in prop::collection::vec(any::<bool>(), 1..16),
+        sigma in 0.1f64..3.0,
+    ) {
+        let mut b = batch_from(n, h, p, l, &values, sigma);
+        // Zero scores in places, so that some baseline denominators vanish.
+        for (x, z) in b.cum_score_v.iter_mut().zip(zeros.iter().cycle()) {
+            if *z {
+                *x = 0.0;
+            }
+        }
+        let mut est = Estimator::new();
+        let mut out = Estimate::new();
+        for baseline in [Baseline::None, Baseline::Mean, Baseline::Optimal] {
+            for fit in [BaselineFit::PlugIn, BaselineFit::LeaveOneOut] {
+                let gp = GradientSpec { kind: Kind::Gpomdp, baseline, fit };
+                let rf = GradientSpec { kind: Kind::Reinforce, baseline, fit };
+                for (target, run) in [
+                    ("v", est.gradient(&b, Param::V, gp, &mut out).map(|_| out.samples().to_vec())),
+                    ("w", est.gradient(&b, Param::W, gp, &mut out).map(|_| out.samples().to_vec())),
+                    ("reinforce", est.gradient(&b, Param::V, rf, &mut out).map(|_| out.samples().to_vec())),
+                    ("h", est.h(&b, baseline, fit, &mut out).map(|_| out.samples().to_vec())),
+                ] {
+                    let got = run.unwrap();
+                    let expected = naive(&b, target, baseline, fit);
+                    let scale = expected.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+                    for (g, e) in got.iter().zip(&expected) {
+                        prop_assert!(
+                            (g - e).abs() <= 1e-9 * scale,
+                            "{target} {baseline:?} {fit:?}: {got:?} vs {expected:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn moderate_batches_give_finite_estimates(
@@ -120,6 +223,38 @@ proptest! {
         ], 1..32),
     ) {
         check_all(&batch_from(n, h, 1, 1, &values, 1.0), true)?;
+    }
+
+    #[test]
+    fn skew_corrected_ends_invert_halls_transformation(
+        values in prop::collection::vec(-10f64..10.0, 3..40),
+        skew in 0.0f64..3.0,
+        delta in 0.01f64..0.5,
+    ) {
+        // Skewed data: x ↦ x + skew · x² / 10.
+        let n = values.len();
+        let mut b = Batch::zeros(n, 1, 1, 1, 0.9);
+        for (r, v) in b.disc_rewards.iter_mut().zip(&values) {
+            *r = v + skew * v * v / 10.0;
+        }
+        let mut e = Estimate::new();
+        Estimator::new().value(&b, &mut e).unwrap();
+        let (mut lo, mut hi) = ([0.0], [0.0]);
+        e.intervals_into(Width::SkewCorrectedT, delta, &mut lo, &mut hi).unwrap();
+        // Hall's g(T) = T + γT²/3 + γ²T³/27 + γ/(6n) at T = (x̄ − end)/s must be ±t/√n.
+        let (mean, s) = (e.mean()[0], e.variance()[0].sqrt());
+        prop_assume!(s > 1e-6);
+        let x = &b.disc_rewards;
+        let gamma = x.iter().map(|v| ((v - mean) / s).powi(3)).sum::<f64>() / n as f64;
+        let g = |t: f64| t + gamma * t * t / 3.0 + gamma * gamma * t.powi(3) / 27.0
+            + gamma / (6.0 * n as f64);
+        let y = student_t_quantile(1.0 - delta / 2.0, n as f64 - 1.0).unwrap() / (n as f64).sqrt();
+        prop_assert!((g((mean - lo[0]) / s) - y).abs() < 1e-9 * (1.0 + y), "lower end");
+        prop_assert!((g((mean - hi[0]) / s) + y).abs() < 1e-9 * (1.0 + y), "upper end");
+        let mut eps = [0.0];
+        e.widths_into(Width::SkewCorrectedT, delta, &mut eps).unwrap();
+        let enclosing = (mean - lo[0]).max(hi[0] - mean);
+        prop_assert!((eps[0] - enclosing).abs() <= 1e-14 * enclosing, "width");
     }
 
     #[test]

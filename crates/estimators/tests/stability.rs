@@ -4,7 +4,7 @@
 use rand::RngCore;
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
-use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, SurrogateEstimate};
+use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, SurrogateEstimate, Width};
 use sepg_mdp::Batch;
 
 /// Uniform on [lo, hi) from the top 53 bits of one Xoshiro256++ output.
@@ -74,6 +74,32 @@ fn pinned_outputs() {
         0x3f72511b79740f51,
         0x3fc3d18ff91e2154,
         0xbf8998cabd07a58e,
+    ];
+    assert_eq!(got, expected, "{got:#018x?}");
+}
+
+#[test]
+fn pinned_skew_corrected_interval() {
+    let b = synthetic();
+    let mut out = Estimate::new();
+    Estimator::new()
+        .gradient(&b, Param::V, GradientSpec::default(), &mut out)
+        .unwrap();
+    let (mut lo, mut hi) = ([0.0; 2], [0.0; 2]);
+    out.intervals_into(Width::SkewCorrectedT, 0.1, &mut lo, &mut hi)
+        .unwrap();
+    let mut eps = [0.0; 2];
+    out.widths_into(Width::SkewCorrectedT, 0.1, &mut eps)
+        .unwrap();
+    let got: Vec<u64> = [lo, hi, eps].iter().flat_map(|x| bits(x)).collect();
+    // Lower ends, upper ends, symmetric widths of the two components of ∇_v J (δ = 0.1).
+    let expected: Vec<u64> = vec![
+        0xbfec49d0bdd34026,
+        0xbfb9ffbe4468ed50,
+        0x3fe34ad4f870c9e6,
+        0x3ff1b98a1304ad56,
+        0x3fea1c1be7e159e9,
+        0x3fe546cdd3abb1f8,
     ];
     assert_eq!(got, expected, "{got:#018x?}");
 }

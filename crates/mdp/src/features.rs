@@ -105,14 +105,26 @@ impl RbfGrid {
         for i in 0..d {
             let k = per_dim[i];
             let span = high[i] - low[i];
-            if k == 1 {
-                axes.push(vec![low[i] + 0.5 * span]);
-                inv_width.push(1.0 / span);
-            } else {
-                let h = span / (k - 1) as f64;
-                axes.push((0..k).map(|j| low[i] + h * j as f64).collect::<Vec<_>>());
-                inv_width.push(1.0 / h);
+            let h = if k == 1 { span } else { span / (k - 1) as f64 };
+            // A box wider than f64::MAX, or a spacing whose inverse overflows, has no usable
+            // width (the features would be NaN).
+            if !(span.is_finite() && (1.0 / h).is_finite()) {
+                return Err(FeatureError::NonFinite {
+                    what: "grid spacing (box too wide or too narrow)",
+                });
             }
+            let axis: Vec<f64> = if k == 1 {
+                vec![low[i] + 0.5 * span]
+            } else {
+                (0..k).map(|j| low[i] + h * j as f64).collect()
+            };
+            if !axis.iter().all(|c| c.is_finite()) {
+                return Err(FeatureError::NonFinite {
+                    what: "grid centres (box too wide)",
+                });
+            }
+            axes.push(axis);
+            inv_width.push(1.0 / h);
         }
         let mut centres = Vec::with_capacity(count * d);
         for c in 0..count {

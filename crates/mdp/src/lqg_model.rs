@@ -430,6 +430,15 @@ impl LqgModel {
         }
         check_psd("q", &self.q)?;
         check_psd("r", &self.r)?;
+        // Finite but huge entries can make the bound constants overflow.
+        for (what, value) in [
+            ("R_max", self.r_max()),
+            ("action volume |A|", self.action_volume()),
+        ] {
+            if !value.is_finite() {
+                return Err(ModelError::NonFinite { what });
+            }
+        }
         Ok(())
     }
 

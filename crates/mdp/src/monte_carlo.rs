@@ -114,15 +114,21 @@ pub fn summarize(samples: &[f64], level: f64) -> Result<McEstimate, McError> {
     let mean = samples.iter().sum::<f64>() / nf;
     let ss: f64 = samples.iter().map(|x| (x - mean) * (x - mean)).sum();
     let std_error = (ss / (nf - 1.0) / nf).sqrt();
-    let z = Normal::standard().inverse_cdf(0.5 + 0.5 * level);
-    if !(mean.is_finite() && std_error.is_finite()) {
+    // The upper quantile from the tail probability (1 − level)/2, exact in f64 even for a
+    // level within an ulp of 1, where 0.5 + 0.5·level would round to 1 and give z = ∞.
+    let z = -Normal::standard().inverse_cdf(0.5 * (1.0 - level));
+    let (ci_low, ci_high) = (mean - z * std_error, mean + z * std_error);
+    if ![mean, std_error, z, ci_low, ci_high]
+        .iter()
+        .all(|x| x.is_finite())
+    {
         return Err(McError::NonFinite);
     }
     Ok(McEstimate {
         mean,
         std_error,
-        ci_low: mean - z * std_error,
-        ci_high: mean + z * std_error,
+        ci_low,
+        ci_high,
         level,
         n,
     })

@@ -288,7 +288,7 @@ impl GaussianPolicy {
         self.check_phi(phi)?;
         check_len("out", out.len(), self.actions)?;
         self.mean_unchecked(phi, out);
-        Ok(())
+        all_finite("mean μ(s) (overflow)", out)
     }
 
     /// Log-density `log π(a|s)` of the raw action `a` at features `φ(s)`.
@@ -313,6 +313,7 @@ impl GaussianPolicy {
             let z = (a[j] - self.mean_j(phi, j)) * self.inv_sigma[j];
             total += -0.5 * z * z - w[j] - half_ln_2pi;
         }
+        all_finite("log-density (overflow)", &[total])?;
         Ok(total)
     }
 
@@ -343,7 +344,7 @@ impl GaussianPolicy {
                 out[j * p + i] = c * phi[i];
             }
         }
-        Ok(())
+        all_finite("v-score (overflow)", out)
     }
 
     /// The w-score `∇_w log π(a|s)` with the raw action, written into `out` (length `l`).
@@ -370,7 +371,7 @@ impl GaussianPolicy {
             let z = (a[j] - self.mean_j(phi, j)) * self.inv_sigma[j];
             *o = z * z - 1.0;
         }
-        Ok(())
+        all_finite("w-score (overflow)", out)
     }
 
     /// Samples an action `a ~ π(·|s)` into `out` (length `l`); the deterministic policy writes
@@ -402,7 +403,7 @@ impl GaussianPolicy {
                 *o += self.sigma[j] * standard_normal(rng);
             }
         }
-        Ok(())
+        all_finite("sampled action (overflow)", out)
     }
 
     /// `σ_j` and `1/σ_j` (empty for the deterministic policy).
@@ -452,6 +453,16 @@ fn check_v(v: &[f64], actions: usize, features: usize) -> Result<(), PolicyError
         });
     }
     check_finite("v", v)
+}
+
+/// `Ok` if every value is finite, else [`PolicyError::NonFinite`] naming `what` (finite
+/// parameters and features can still overflow in μ = Vᵀφ or in the scores).
+fn all_finite(what: &'static str, values: &[f64]) -> Result<(), PolicyError> {
+    if values.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(PolicyError::NonFinite { what })
+    }
 }
 
 fn check_len(what: &'static str, found: usize, expected: usize) -> Result<(), PolicyError> {

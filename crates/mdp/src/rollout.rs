@@ -57,6 +57,10 @@ pub enum RolloutError {
     /// `n · horizon · dim_v` overflows `usize`.
     #[error("the batch size overflows the address space")]
     TooLarge,
+    /// A reward, score or return overflowed to ±∞ or NaN (diverging dynamics or huge policy
+    /// parameters on an unclipped environment).
+    #[error("a reward, score or return is not finite (diverging dynamics or overflow)")]
+    NonFinite,
 }
 
 /// Rolls out `n` trajectories of at most `horizon` steps with the stochastic `policy` and
@@ -148,7 +152,12 @@ pub fn rollout_into<E: Environment + ?Sized>(
             generic_kernel::<E, true>(env, policy, gamma, limit, rngs, rw, sv, sw, sc).0
         });
     }
-    Ok(())
+    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
+    if finite(&batch.disc_rewards) && finite(&batch.cum_score_v) && finite(&batch.cum_score_w) {
+        Ok(())
+    } else {
+        Err(RolloutError::NonFinite)
+    }
 }
 
 /// The discounted returns `G_i = Σ_t γ^t r_t` of `n` trajectories, without scores (the fast
@@ -241,7 +250,11 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
             .1
         });
     }
-    Ok(())
+    if out.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(RolloutError::NonFinite)
+    }
 }
 
 /// The Monte Carlo estimate `Ĵ = (1/n) Σ_i G_i` of the expected discounted return (eq. 2.1's
@@ -266,7 +279,12 @@ pub fn mean_return<E: Environment + ?Sized>(
     key: SeedKey,
 ) -> Result<f64, RolloutError> {
     let g = rollout_returns(env, policy, n, horizon, key)?;
-    Ok(g.iter().sum::<f64>() / n as f64)
+    let mean = g.iter().sum::<f64>() / n as f64;
+    if mean.is_finite() {
+        Ok(mean)
+    } else {
+        Err(RolloutError::NonFinite)
+    }
 }
 
 /// The Monte Carlo estimate of `J(v, −∞)`, the performance of the deterministic policy that

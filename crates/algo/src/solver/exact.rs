@@ -1,6 +1,6 @@
 //! Exact J and gradients from an oracle of `sepg_mdp::oracle` (the setting of Sec 4.3).
 use sepg_bounds::constants::TaskConstants;
-use sepg_mdp::oracle::{ExactOracle, Exploration, Horizon};
+use sepg_mdp::oracle::{ExactOracle, Exploration, Horizon, Needs};
 
 use crate::core::error::RunError;
 use crate::solver::source::{Estimate, Grad, GradientSource, Query};
@@ -33,9 +33,16 @@ impl GradientSource for ExactSource {
             Some(w) => Exploration::Gaussian { w: w.to_vec() },
             None => Exploration::Deterministic,
         };
+        // Only what the block uses: the Hessian is never needed, and the target block needs J.
+        let needs = Needs {
+            grad_v: q.need.grad_v,
+            grad_w: q.need.grad_wj || q.need.grad_wl,
+            mixed: q.need.grad_wl,
+            hessian: false,
+        };
         let e = self
             .oracle
-            .evaluate(q.v, &exploration, self.horizon)
+            .evaluate_with(q.v, &exploration, self.horizon, needs)
             .map_err(|err| RunError::Mdp(err.to_string()))?;
         let grad_wl = if q.need.grad_wl {
             Some(Grad::exact(steps::surrogate_grad_w(

@@ -63,3 +63,97 @@ fn overflow_is_a_typed_error() {
         Err(BoundsError::Overflow { .. })
     ));
 }
+
+/// Regression (robustness property): with |∇̂_w J| = 1e-170 the squared corrected norms
+/// underflow to 0, so the bound had a⁻ = b = 0 and `vertex()` = 0/0 = NaN. The constructors
+/// now return a typed error whenever the vertex or C_max is not representable.
+#[test]
+fn high_probability_bounds_never_hold_an_unrepresentable_vertex() {
+    use sepg_bounds::high_probability::HighProbabilityBound;
+    let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0).unwrap();
+    let tiny = [
+        HighProbabilityBound::w_along_j(&k, 1e154, -1e-170, 5.5e-221),
+        HighProbabilityBound::v_update(&k, 1.0, &[1e-170], 0.0),
+        HighProbabilityBound::w_along_l(&k, 1.0, 1e-170, 0.0, 1e-170, 0.0),
+    ];
+    for r in tiny {
+        match r {
+            Ok(Some(b)) => panic!("unrepresentable bound returned: {b:?}"),
+            Ok(None) => panic!("an estimate above its width is not below noise"),
+            Err(e) => assert!(matches!(e, BoundsError::Overflow { .. }), "{e:?}"),
+        }
+    }
+    // Representable small gradients still give finite bounds.
+    let b = HighProbabilityBound::w_along_j(&k, 1.0, -1e-100, 0.0)
+        .unwrap()
+        .unwrap();
+    assert!(b.vertex().is_finite() && b.vertex() > 0.0 && b.c_max().is_finite());
+}
+
+/// Regression (fuzzing): `kl2(f64::MAX)` returned `Ok(inf)` because 2|Δw| overflows.
+#[test]
+fn kl2_of_a_huge_step_is_an_overflow_error() {
+    assert!(matches!(
+        rigorous::kl2(f64::MAX),
+        Err(BoundsError::Overflow { .. })
+    ));
+    assert!(matches!(
+        rigorous::kl2(-f64::MAX),
+        Err(BoundsError::Overflow { .. })
+    ));
+    let big = rigorous::kl2(1e300).unwrap();
+    assert_eq!(big, 2e300 - 1.0);
+}
+
+/// Regression (fuzzing): finite performances near ±f64::MAX made the budget's reported
+/// baseline, average or telescoped change ±∞. Construction and updates that would do so are
+/// now overflow errors that leave the budget unchanged.
+#[test]
+fn budget_never_reports_an_overflowed_quantity() {
+    use sepg_bounds::budget::Budget;
+    let max = f64::MAX;
+    assert!(matches!(
+        Budget::new(max, -max, Some(-max)),
+        Err(BoundsError::Overflow { .. })
+    ));
+    assert!(matches!(
+        Budget::new(-max, max, None),
+        Err(BoundsError::Overflow { .. })
+    ));
+    let mut b = Budget::new(0.0, max, None).unwrap();
+    let before = b.clone();
+    assert!(matches!(
+        b.record_exploratory(-max),
+        Err(BoundsError::Overflow { .. })
+    ));
+    assert_eq!(b, before);
+    let mut t = Budget::new(0.0, max, Some(0.0)).unwrap();
+    let before = t.clone();
+    assert!(matches!(
+        t.add_target_difference(max),
+        Err(BoundsError::Overflow { .. })
+    ));
+    assert_eq!(t, before);
+    for x in [
+        t.baseline(),
+        t.average_performance(),
+        t.telescoped_change(),
+        t.guaranteed_average(),
+    ] {
+        assert!(x.is_finite());
+    }
+}
+
+/// Regression (fuzzing): with a subnormal C_max (5e-324) and C = C_max, the small root
+/// C/(b·hi) lost its precision and the safe interval came out with lo > hi.
+#[test]
+fn safe_intervals_are_ordered_even_for_a_subnormal_c_max() {
+    use sepg_bounds::outcome::StepOutcome;
+    let k = TaskConstants::new(2.220446049250313e-16, 0.5, 1e-154, 0.9999999999999999).unwrap();
+    let sigma = 2.220446049250313e-16;
+    let out = w_update::safe_step_along_j(&k, sigma, 1e-154, 5e-324).unwrap();
+    let StepOutcome::Feasible(s) = out else {
+        panic!("C = C_max is feasible: {out:?}")
+    };
+    assert!(s.lo <= s.vertex && s.vertex <= s.hi, "{s:?}");
+}

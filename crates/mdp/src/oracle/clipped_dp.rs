@@ -11,9 +11,11 @@
 //!   exactly with the normal CDF and truncated normal moments;
 //! - inside the action box the next state `y = A s + B a` is affine in `z`; where `y` leaves
 //!   the state box the clipped next state is a constant (the state point mass, again exact);
-//!   elsewhere `φ(z) V_{t+1}(y(z))` is integrated by Gauss–Legendre on pieces of unit width in
-//!   `z` split at the element boundaries of the interpolant, `|z| ≤ 10` (neglected mass
-//!   `< 2·10⁻²³`);
+//!   elsewhere `φ(z) V_{t+1}(y(z))` is integrated by Gauss–Legendre on pieces at most two
+//!   units wide in `z` (five points per unit), split at the element boundaries of the
+//!   interpolant, `|z| ≤ 10` (neglected mass `< 2·10⁻²³`); between element boundaries the
+//!   pieces are fixed sub-intervals of the element, whose interpolation weights are tabulated
+//!   once per evaluation;
 //! - the reward term is integrated in closed form.
 //!
 //! The derivatives are carried along the recursion in score-function form, which never
@@ -32,7 +34,12 @@
 //!
 //! The interpolant elements are placed at the exact kinks of `V_t` (from the clipped-action
 //! branches) and refined near every smoothed clipping feature, with a width proportional to
-//! the feature's scale (`σ/|v|` for action clipping, `|B|σ/|A + Bv|` for state clipping).
+//! the feature's scale (`σ/|v|` for action clipping, `|B|σ/|A + Bv|` for state clipping, and
+//! their images under the closed loop at earlier steps, which matter near `A + Bv = 1`).
+//!
+//! Only the channels a request needs are propagated ([`Needs`]): `J` alone integrates one
+//! weight per operator entry and carries one channel; SEPG's `J`, `∂_v J`, `∂_w J`,
+//! `∂²_{wv} J` integrate four and carry four; the Hessian five and six.
 //!
 //! The deterministic policy without transition noise is computed exactly by propagating
 //! intervals of initial states on which the trajectory is affine in `s_0` (piecewise-linear
@@ -45,6 +52,9 @@ use nalgebra::DMatrix;
 
 /// Half-width of the truncated `z`-range of the Gaussian integrals.
 const Z_MAX: f64 = 10.0;
+/// Width in `z` of the Gauss–Legendre pieces of the Gaussian integrals (with the default 10
+/// points per piece: 5 points per unit of `z`).
+const PIECE_WIDTH: f64 = 2.0;
 /// A smoothed feature of scale `ℓ` matters within `ZONE_HALF_WIDTH · ℓ` of its centre.
 const ZONE_HALF_WIDTH: f64 = 8.0;
 /// Kinks of the value function whose producing chain of clipped actions has a smaller
@@ -59,10 +69,15 @@ const MAX_PIECES: usize = 1_000_000;
 
 /// Resolution of the dynamic programme of [`ClippedDpOracle`].
 ///
-/// With the defaults, `J`, `∂_v J`, `∂_w J` and `∂²_{wv} J` are within `3e-11 · |J|` of a
-/// four-times finer reference on the convergence-study cases of `tests/oracle_dp.rs`
-/// (`v ∈ [−1.8, 1.2]`, `σ ∈ [0.1, 0.5]`, with and without noise); the error shrinks by two to
-/// three orders of magnitude per two extra nodes per element.
+/// With the defaults, on a grid of `v ∈ [−1.5, 0.2]`, `σ ∈ [0.02, 2]`, `H = 20` over both
+/// presets (98 points, `A + Bv = 1` included), `J` is within `7e-11 · max(|J|, 1)` and
+/// `∂_v J`, `∂_w J`, `∂²_{wv} J` within `2e-8 · max(|J|, 1)` of a much finer reference (16
+/// nodes, 2 to 6 times narrower elements), and within `1e-9 · max(|J|, 1)` for
+/// `σ ∈ [10⁻³, 0.02]`; `tests/oracle_dp.rs` checks `1e-9` and `1e-7` on its
+/// convergence-study cases. The error shrinks by about two orders of magnitude per two extra
+/// nodes per element. Smaller `σ` stays finite and tends to the deterministic policy, or
+/// fails with [`OracleError::ResolutionExceeded`] when the features of an expanding closed
+/// loop (`|A + Bv| > 1`) need more than `max_elements` elements.
 ///
 /// # Formula
 /// ```text
@@ -84,7 +99,7 @@ pub struct DpConfig {
 
 impl Default for DpConfig {
     /// `nodes_per_element = 10`, `quad_points = 10`, `min_elements = 8`,
-    /// `elements_per_scale = 1`, `max_elements = 2000`.
+    /// `elements_per_scale = 0.7`, `max_elements = 2000`.
     ///
     /// ```
     /// assert_eq!(sepg_mdp::oracle::DpConfig::default().nodes_per_element, 10);
@@ -94,7 +109,7 @@ impl Default for DpConfig {
             nodes_per_element: 10,
             quad_points: 10,
             min_elements: 8,
-            elements_per_scale: 1.0,
+            elements_per_scale: 0.7,
             max_elements: 2000,
         }
     }
@@ -293,8 +308,7 @@ impl RowAcc {
                 off: op.vals.len(),
             };
             for k in 0..op.kmax {
-                op.vals
-                    .extend(self.acc[first..=last].iter().map(|a| a[k]));
+                op.vals.extend(self.acc[first..=last].iter().map(|a| a[k]));
             }
             op.segs.push(seg);
             i = j;
@@ -308,8 +322,6 @@ impl RowAcc {
     }
 }
 
-pub static DBG_PTS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-fn piece_width() -> f64 { std::env::var("PW").map(|x| x.parse().unwrap()).unwrap_or(1.0) }
 /// Largest number of fixed sub-pieces per element with a cached weight table.
 const MAX_SUB_PIECES: usize = 256;
 
@@ -356,56 +368,47 @@ impl Quad {
     }
 }
 
-/// Channel indices: `V`, `∂_v V`, `∂_w V`, `∂²_vv V`, `∂²_wv V`, `∂²_ww V`.
-const VAL: usize = 0;
-const DV: usize = 1;
-const DW: usize = 2;
-const DVV: usize = 3;
-const DVW: usize = 4;
-const DWW: usize = 5;
-
-/// The channels a request needs and the powers of `z` each is integrated against.
-#[derive(Debug, Clone, Copy)]
-struct Active {
-    /// Channel `c` is propagated.
-    on: [bool; 6],
-    /// Powers `z^k`, `k < kmax`, integrated against `V` (the reward moments likewise).
-    kmax: usize,
-    /// Powers integrated against `∂_v V`.
-    kv: usize,
-    /// Powers integrated against `∂_w V`.
-    kw: usize,
+/// The channels a request needs: `∂_w` comes with `∂_v` (nearly free), `∂²_wv` needs both,
+/// the Hessian everything.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Level {
+    /// `V`.
+    Value,
+    /// `V`, `∂_v V`.
+    GradV,
+    /// `V`, `∂_v V`, `∂_w V`.
+    Grad,
+    /// `V`, `∂_v V`, `∂_w V`, `∂²_wv V`.
+    Mixed,
+    /// All six channels.
+    Hessian,
 }
 
-impl From<Needs> for Active {
-    /// `∂²_wv` needs `∂_v` and `∂_w`; the Hessian needs everything.
+impl From<Needs> for Level {
     fn from(needs: Needs) -> Self {
-        let hess = needs.hessian;
-        let mixed = needs.mixed || hess;
-        let dv = needs.grad_v || mixed;
-        let dw = needs.grad_w || mixed;
-        let kmax = if hess {
-            5
-        } else if mixed {
-            4
-        } else if dw {
-            3
-        } else if dv {
-            2
+        if needs.hessian {
+            Level::Hessian
+        } else if needs.mixed {
+            Level::Mixed
+        } else if needs.grad_w {
+            Level::Grad
+        } else if needs.grad_v {
+            Level::GradV
         } else {
-            1
-        };
-        Active {
-            on: [true, dv, dw, hess, mixed, hess],
-            kmax,
-            kv: if mixed { 3 } else { 1 },
-            kw: if hess {
-                3
-            } else if mixed {
-                2
-            } else {
-                1
-            },
+            Level::Value
+        }
+    }
+}
+
+impl Level {
+    /// Powers `z^k`, `k < kmax`, of the operator weights the level integrates.
+    fn kmax(self) -> usize {
+        match self {
+            Level::Value => 1,
+            Level::GradV => 2,
+            Level::Grad => 3,
+            Level::Mixed => 4,
+            Level::Hessian => 5,
         }
     }
 }
@@ -755,7 +758,6 @@ impl ClippedDpOracle {
             );
             let mut local = [[0.0; MAX_NODES]; 5];
             let mut acc = |z: f64, weight: f64, l: &[f64]| {
-                DBG_PTS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 let base = weight * norm_pdf(z);
                 let mut zk = 1.0;
                 for c in coef.iter_mut().take(kmax) {
@@ -770,7 +772,7 @@ impl ClippedDpOracle {
             };
             let (b0, b1) = (t.grid.breaks[e], t.grid.breaks[e + 1]);
             let (mid_e, half_e) = (0.5 * (b0 + b1), 0.5 * (b1 - b0));
-            let sub = ((b1 - b0) / (y1.abs() * piece_width())).ceil();
+            let sub = ((b1 - b0) / (y1.abs() * PIECE_WIDTH)).ceil();
             let table = if !ha && !hb && sub <= MAX_SUB_PIECES as f64 {
                 quad.table(self, sub.max(1.0) as usize)
             } else {
@@ -799,7 +801,7 @@ impl ClippedDpOracle {
                     }
                 }
             } else {
-                let pieces = ((zb - za) / piece_width()).ceil().max(1.0);
+                let pieces = ((zb - za) / PIECE_WIDTH).ceil().max(1.0);
                 let hz = (zb - za) / pieces;
                 for i in 0..pieces as usize {
                     let pa = za + hz * i as f64;
@@ -871,7 +873,7 @@ impl ClippedDpOracle {
 
     /// Zones of the smoothed clipping features of `V_t` and the global scale of features
     /// created by an expanding closed loop (`|A + Bv| > 1`).
-    fn zones(&self, v: f64, sigma: f64) -> (Vec<Zone>, f64) {
+    fn zones(&self, v: f64, sigma: f64, horizon: usize) -> (Vec<Zone>, f64) {
         let mut zones = Vec::new();
         let lam = self.a + self.b * v;
         let spread = (self.b * self.b * sigma * sigma + self.noise * self.noise).sqrt();
@@ -889,6 +891,33 @@ impl ClippedDpOracle {
                     centre: sb / lam,
                     scale: spread / lam.abs(),
                 });
+            }
+        }
+        // Earlier steps see each feature through the closed loop `s ↦ λ s + spread · ξ`: at
+        // `c/λ`, widened to `√(ℓ² + spread²)/|λ|`. With `|λ| > 1` the global scale covers
+        // these; with `|λ| ≤ 1` they leave the box or widen beyond the base resolution,
+        // except near `λ = 1`, where the features at the state bounds pile up with scales
+        // `spread·√k` (a diffusion). Only zones that refine the base grid are kept.
+        let coarse = (self.s_hi - self.s_lo) / self.config.min_elements as f64
+            * self.config.elements_per_scale;
+        if lam != 0.0 && lam.abs() <= 1.0 && spread > 0.0 {
+            let base = zones.len();
+            for z in 0..base {
+                let Zone {
+                    mut centre,
+                    mut scale,
+                } = zones[z];
+                for _ in 1..horizon {
+                    centre /= lam;
+                    scale = scale.hypot(spread) / lam.abs();
+                    if scale >= coarse {
+                        break;
+                    }
+                    let reach = ZONE_HALF_WIDTH * scale;
+                    if centre - reach < self.s_hi && centre + reach > self.s_lo {
+                        zones.push(Zone { centre, scale });
+                    }
+                }
             }
         }
         if self.noise > 0.0 && self.a != 0.0 {
@@ -930,7 +959,7 @@ impl ClippedDpOracle {
         sigma: f64,
         horizon: usize,
     ) -> Result<(Grid, Option<Grid>), OracleError> {
-        let (zones, global) = self.zones(v, sigma);
+        let (zones, global) = self.zones(v, sigma, horizon);
         let mut kinks = if self.noise == 0.0 && sigma > 0.0 {
             self.exact_kinks(v, sigma, horizon)?
         } else {
@@ -979,7 +1008,9 @@ impl ClippedDpOracle {
         let mut row = RowAcc::new(vgrid.nodes.len());
         let mut quad = Quad::new(vgrid.p);
         for &y in &wgrid.nodes {
-            self.add_gauss(&mut row, &target, y, self.noise, -Z_MAX, Z_MAX, 2, &mut quad);
+            self.add_gauss(
+                &mut row, &target, y, self.noise, -Z_MAX, Z_MAX, 2, &mut quad,
+            );
             row.flush(&mut op);
         }
         op
@@ -1087,9 +1118,8 @@ impl ClippedDpOracle {
         horizon: usize,
         needs: Needs,
     ) -> Result<ExactEval, OracleError> {
-        let act = Active::from(needs);
+        let level = Level::from(needs);
         let (vgrid, wgrid) = self.grids(v, sigma, horizon)?;
-        let n = vgrid.nodes.len();
         let noise_op = wgrid.as_ref().map(|wg| self.noise_operator(&vgrid, wg));
         let target = match &wgrid {
             Some(wg) => Target {
@@ -1101,64 +1131,45 @@ impl ClippedDpOracle {
                 clip: Some((self.s_lo, self.s_hi)),
             },
         };
-        let (op, rew) = self.action_operator(v, sigma, &vgrid, &target, act.kmax);
-        let g = self.gamma;
-        let m = target.grid.nodes.len();
-        // Channels: V, ∂_v V, ∂_w V, ∂²_vv V, ∂²_wv V, ∂²_ww V on the V grid (`cur`), and
-        // their images under the noise operator on the W grid (`smooth`).
-        let mut cur: [Vec<f64>; 6] = std::array::from_fn(|c| vec![0.0; if act.on[c] { n } else { 0 }]);
-        let mut smooth: [Vec<f64>; 6] = std::array::from_fn(|c| {
-            vec![0.0; if act.on[c] && noise_op.is_some() { m } else { 0 }]
-        });
-        let (mut sg, mut sv, mut sw) = ([0.0; 5], [0.0; 3], [0.0; 3]);
-        let (mut svv, mut svw, mut sww) = ([0.0; 1], [0.0; 1], [0.0; 1]);
-        for _ in 0..horizon {
-            if let Some(nop) = &noise_op {
-                for (c, out) in smooth.iter_mut().enumerate() {
-                    if act.on[c] {
-                        nop.apply_k0(&cur[c], out);
-                    }
-                }
-            }
-            let src = if noise_op.is_some() { &smooth } else { &cur };
-            let mut next: [Vec<f64>; 6] =
-                std::array::from_fn(|c| vec![0.0; if act.on[c] { n } else { 0 }]);
-            for (i, (rw, &s)) in rew.iter().zip(&vgrid.nodes).enumerate() {
-                op.row_dots(i, &src[VAL], &mut sg[..act.kmax]);
-                let eg: [f64; 5] = std::array::from_fn(|k| rw[k] + g * sg[k]);
-                next[VAL][i] = eg[0];
-                let so = s / sigma;
-                if act.on[DV] {
-                    op.row_dots(i, &src[DV], &mut sv[..act.kv]);
-                    next[DV][i] = so * eg[1] + g * sv[0];
-                }
-                if act.on[DW] {
-                    op.row_dots(i, &src[DW], &mut sw[..act.kw]);
-                    next[DW][i] = eg[2] - eg[0] + g * sw[0];
-                }
-                if act.on[DVW] {
-                    op.row_dots(i, &src[DVW], &mut svw);
-                    next[DVW][i] = so * (eg[3] - 3.0 * eg[1])
-                        + g * (so * sw[1] + sv[2] - sv[0] + svw[0]);
-                }
-                if act.on[DVV] {
-                    op.row_dots(i, &src[DVV], &mut svv);
-                    op.row_dots(i, &src[DWW], &mut sww);
-                    next[DVV][i] = so * so * (eg[2] - eg[0]) + g * (2.0 * so * sv[1] + svv[0]);
-                    next[DWW][i] = (eg[4] - 4.0 * eg[2] + eg[0])
-                        + g * (2.0 * (sw[2] - sw[0]) + sww[0]);
-                }
-            }
-            cur = next;
-        }
+        let (op, rew) = self.action_operator(v, sigma, &vgrid, &target, level.kmax());
+        let rec = Recursion {
+            op: &op,
+            noise: noise_op.as_ref(),
+            rew: &rew,
+            nodes: &vgrid.nodes,
+            sigma,
+            gamma: self.gamma,
+            horizon,
+        };
+        let ch = match level {
+            Level::Hessian => rec.run::<5, 3, 3, 3>(),
+            Level::Mixed => rec.run::<4, 3, 2, 1>(),
+            Level::Grad => rec.run::<3, 1, 1, 0>(),
+            Level::GradV => rec.run::<2, 1, 0, 0>(),
+            Level::Value => rec.run::<1, 0, 0, 0>(),
+        };
         let iw = self.init_weights(&vgrid);
-        let [j, dv, dw, dvv, dvw, dww] = cur.map(|x| iw.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>());
+        let [j, dv, dw, dvw, dvv, dww] =
+            ch.map(|x| iw.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>());
         finish(ExactEval {
             j,
-            grad_v: if act.on[DV] { vec![dv] } else { Vec::new() },
-            grad_w: if act.on[DW] { vec![dw] } else { Vec::new() },
-            mixed_wv: if act.on[DVW] { vec![dvw] } else { Vec::new() },
-            hessian: act.on[DVV].then(|| DMatrix::from_row_slice(2, 2, &[dvv, dvw, dvw, dww])),
+            grad_v: if level >= Level::GradV {
+                vec![dv]
+            } else {
+                Vec::new()
+            },
+            grad_w: if level >= Level::Grad {
+                vec![dw]
+            } else {
+                Vec::new()
+            },
+            mixed_wv: if level >= Level::Mixed {
+                vec![dvw]
+            } else {
+                Vec::new()
+            },
+            hessian: (level == Level::Hessian)
+                .then(|| DMatrix::from_row_slice(2, 2, &[dvv, dvw, dvw, dww])),
             sigma: vec![sigma],
         })
     }
@@ -1309,6 +1320,163 @@ impl ClippedDpOracle {
             hessian: None,
             sigma: Vec::new(),
         })
+    }
+}
+
+/// The backward recursion of the stochastic policy (module documentation) on the `V` grid.
+struct Recursion<'a> {
+    op: &'a SpanOp,
+    noise: Option<&'a SpanOp>,
+    rew: &'a [[f64; 5]],
+    nodes: &'a [f64],
+    sigma: f64,
+    gamma: f64,
+    horizon: usize,
+}
+
+impl Recursion<'_> {
+    /// Runs `horizon` steps and returns the channels `[V, ∂_v V, ∂_w V, ∂²_wv V, ∂²_vv V,
+    /// ∂²_ww V]` at the nodes (empty when not propagated). `KX`, `KV`, `KW`: powers of `z`
+    /// integrated against `V`, `∂_v V`, `∂_w V`; `K2`: second-order channels propagated
+    /// (`∂²_wv`, then `∂²_vv`, `∂²_ww`).
+    fn run<const KX: usize, const KV: usize, const KW: usize, const K2: usize>(
+        &self,
+    ) -> [Vec<f64>; 6] {
+        let n = self.nodes.len();
+        let sized = |on: bool| vec![0.0; if on { n } else { 0 }];
+        let mut cur: [Vec<f64>; 6] = [
+            sized(true),
+            sized(KV > 0),
+            sized(KW > 0),
+            sized(K2 > 0),
+            sized(K2 > 1),
+            sized(K2 > 2),
+        ];
+        let mut next = cur.clone();
+        let mut smooth: [Vec<f64>; 6] = match self.noise {
+            Some(nop) => {
+                std::array::from_fn(|c| vec![0.0; if cur[c].is_empty() { 0 } else { nop.rows() }])
+            }
+            None => Default::default(),
+        };
+        let (g, sigma) = (self.gamma, self.sigma);
+        for _ in 0..self.horizon {
+            if let Some(nop) = self.noise {
+                for (out, x) in smooth.iter_mut().zip(&cur) {
+                    if !x.is_empty() {
+                        nop.apply_k0(x, out);
+                    }
+                }
+            }
+            let src = if self.noise.is_some() { &smooth } else { &cur };
+            let x2: [&[f64]; K2] = std::array::from_fn(|j| src[3 + j].as_slice());
+            for (i, (rw, &s)) in self.rew.iter().zip(self.nodes).enumerate() {
+                let (mut sx, mut sv, mut sw, mut s2) = ([0.0; KX], [0.0; KV], [0.0; KW], [0.0; K2]);
+                for seg in self.op.row(i) {
+                    seg_sums(
+                        self.op, seg, &src[0], &src[1], &src[2], &x2, &mut sx, &mut sv, &mut sw,
+                        &mut s2,
+                    );
+                }
+                let eg: [f64; KX] = std::array::from_fn(|k| rw[k] + g * sx[k]);
+                next[0][i] = eg[0];
+                let so = s / sigma;
+                if KV > 0 {
+                    next[1][i] = so * eg[1] + g * sv[0];
+                }
+                if KW > 0 {
+                    next[2][i] = eg[2] - eg[0] + g * sw[0];
+                }
+                if K2 > 0 {
+                    next[3][i] =
+                        so * (eg[3] - 3.0 * eg[1]) + g * (so * sw[1] + sv[2] - sv[0] + s2[0]);
+                }
+                if K2 > 2 {
+                    next[4][i] = so * so * (eg[2] - eg[0]) + g * (2.0 * so * sv[1] + s2[1]);
+                    next[5][i] =
+                        (eg[4] - 4.0 * eg[2] + eg[0]) + g * (2.0 * (sw[2] - sw[0]) + s2[2]);
+                }
+            }
+            std::mem::swap(&mut cur, &mut next);
+        }
+        cur
+    }
+}
+
+/// Adds one run's contributions `Σ_c w_k[c] x[c]` to `sx[k]` (`k < KX`), likewise `sv` for
+/// `∂_v V`, `sw` for `∂_w V`, and `Σ_c w_0[c] x2_j[c]` to `s2[j]`; two interleaved partial
+/// sums per quantity (a fixed order: deterministic).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn seg_sums<const KX: usize, const KV: usize, const KW: usize, const K2: usize>(
+    op: &SpanOp,
+    seg: &Seg,
+    x: &[f64],
+    xv: &[f64],
+    xw: &[f64],
+    x2: &[&[f64]; K2],
+    sx: &mut [f64; KX],
+    sv: &mut [f64; KV],
+    sw: &mut [f64; KW],
+    s2: &mut [f64; K2],
+) {
+    let len = seg.len;
+    let w: [&[f64]; KX] = std::array::from_fn(|k| op.weights(seg, k));
+    let cols = seg.start..seg.start + len;
+    let x = &x[cols.clone()];
+    let xv = if KV > 0 { &xv[cols.clone()] } else { &[][..] };
+    let xw = if KW > 0 { &xw[cols.clone()] } else { &[][..] };
+    let x2: [&[f64]; K2] = std::array::from_fn(|j| &x2[j][cols.clone()]);
+    let (mut ax, mut av, mut aw, mut a2) = (
+        [[0.0; 2]; KX],
+        [[0.0; 2]; KV],
+        [[0.0; 2]; KW],
+        [[0.0; 2]; K2],
+    );
+    let mut c = 0;
+    while c + 2 <= len {
+        for l in 0..2 {
+            let cc = c + l;
+            for k in 0..KX {
+                ax[k][l] += w[k][cc] * x[cc];
+            }
+            for k in 0..KV {
+                av[k][l] += w[k][cc] * xv[cc];
+            }
+            for k in 0..KW {
+                aw[k][l] += w[k][cc] * xw[cc];
+            }
+            for j in 0..K2 {
+                a2[j][l] += w[0][cc] * x2[j][cc];
+            }
+        }
+        c += 2;
+    }
+    if c < len {
+        for k in 0..KX {
+            ax[k][0] += w[k][c] * x[c];
+        }
+        for k in 0..KV {
+            av[k][0] += w[k][c] * xv[c];
+        }
+        for k in 0..KW {
+            aw[k][0] += w[k][c] * xw[c];
+        }
+        for j in 0..K2 {
+            a2[j][0] += w[0][c] * x2[j][c];
+        }
+    }
+    for (s, a) in sx.iter_mut().zip(&ax) {
+        *s += a[0] + a[1];
+    }
+    for (s, a) in sv.iter_mut().zip(&av) {
+        *s += a[0] + a[1];
+    }
+    for (s, a) in sw.iter_mut().zip(&aw) {
+        *s += a[0] + a[1];
+    }
+    for (s, a) in s2.iter_mut().zip(&a2) {
+        *s += a[0] + a[1];
     }
 }
 

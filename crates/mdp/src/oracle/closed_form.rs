@@ -127,7 +127,7 @@ impl ClosedFormOracle {
     ///
     /// # Errors
     /// Wrong length or non-finite `v`; [`OracleError::NotConverged`] if the Schur
-    /// decomposition fails.
+    /// decomposition fails; [`OracleError::Overflow`] if `A + BV` or the radius overflows.
     ///
     /// ```
     /// use sepg_mdp::lqg_model::LqgModel;
@@ -138,7 +138,15 @@ impl ClosedFormOracle {
     pub fn scaled_spectral_radius(&self, v: &[f64]) -> Result<f64, OracleError> {
         check_params(v, &Exploration::Deterministic, self.dim_v(), self.dim_w())?;
         let k = &self.a + &self.b * self.gain_matrix(v);
-        Ok(self.gamma.sqrt() * spectral_radius(k)?)
+        if !k.iter().all(|x| x.is_finite()) {
+            return Err(OracleError::Overflow);
+        }
+        let rho = self.gamma.sqrt() * spectral_radius(k)?;
+        if rho.is_finite() {
+            Ok(rho)
+        } else {
+            Err(OracleError::Overflow)
+        }
     }
 
     /// The matrix `V` (l×n) from its action-major flattening.

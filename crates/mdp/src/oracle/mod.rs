@@ -338,9 +338,8 @@ pub trait ExactOracle {
         v: &[f64],
         exploration: &Exploration,
         horizon: Horizon,
-        needs: Needs,
+        _needs: Needs,
     ) -> Result<ExactEval, OracleError> {
-        let _ = needs;
         self.evaluate(v, exploration, horizon)
     }
 
