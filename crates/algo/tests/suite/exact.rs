@@ -43,15 +43,14 @@ fn first_violation(req: Requirement, records: &[Record], label: &str) -> Option<
             _ => {}
         }
     }
-    if req.is_type_two() {
-        if let Some(r) = records.iter().find(|r| r.budget < -slack(r.j_exploratory)) {
-            return Some(format!(
-                "{label}: budget {} < 0 at iteration {}",
-                r.budget, r.iteration
-            ));
-        }
+    let negative = records.iter().find(|r| r.budget < -slack(r.j_exploratory));
+    match negative {
+        Some(r) if req.is_type_two() => Some(format!(
+            "{label}: budget {} < 0 at iteration {}",
+            r.budget, r.iteration
+        )),
+        _ => None,
     }
-    None
 }
 
 /// Runs every (preset, requirement, σ⁰) combination in parallel (each run is sequential and
