@@ -668,29 +668,11 @@ fn widths(range: f64) -> [Width; 4] {
     ]
 }
 
-/// Open findings of `sepg-estimators` (docs/RELIABILITY.md, findings E1–E3), accepted here
-/// until the crate returns a typed error for them; every other non-finite `Ok` still fails.
-///
-/// - E1: a width is +∞ for δ < 4/f64::MAX (`ln(2/δ)`, `ln(4/δ)` and `1/√(nδ)` overflow);
-/// - E2: a Hoeffding or empirical-Bernstein width is +∞ for a range above ~1e305;
-/// - E3: `student_t_quantile(p, ν)` is −∞ for p below ~1e-308 (ν = 1: `tan` overflows).
-mod open_findings {
-    /// E1 and E2.
-    pub fn width(delta: f64, range: f64) -> bool {
-        delta < 4.0 / f64::MAX || range > 1e300
-    }
-
-    /// E3.
-    pub fn t_quantile(p: f64) -> bool {
-        p < 1e-300
-    }
-}
-
-/// Like [`ok`] for a confidence width, except for the open findings E1 and E2.
+/// Like [`ok`] for a confidence width.
 fn ok_width<T: AllFinite + Debug, E>(c: &EstimatorsCase, name: &str, result: Result<T, E>) {
     if let Ok(value) = result {
         assert!(
-            value.all_finite() || open_findings::width(c.s[0], c.s[1]),
+            value.all_finite(),
             "{name} returned a non-finite value {value:?} for {c:?}"
         );
     }
@@ -720,8 +702,7 @@ pub fn estimators_case(c: &EstimatorsCase) {
     let s = &c.s;
     ok(c, "normal_quantile", normal_quantile(s[4]));
     if let Ok(t) = student_t_quantile(s[4], s[5]) {
-        let accepted = t.is_finite() || open_findings::t_quantile(s[4]);
-        assert!(accepted, "student_t_quantile returned {t} for {c:?}");
+        assert!(t.is_finite(), "student_t_quantile returned {t} for {c:?}");
     }
     for method in widths(s[1]) {
         ok_width(c, "width", width(method, s[6], c.n, s[0]));

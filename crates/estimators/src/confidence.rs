@@ -91,7 +91,19 @@ pub fn width(method: Width, variance: f64, n: usize, delta: f64) -> Result<f64, 
             method: "skew-corrected Student-t",
         });
     }
-    Ok(Factors::new(method, n, delta)?.width(variance))
+    finite_width(Factors::new(method, n, delta)?.width(variance))
+}
+
+/// A width, or [`EstimatorError::NonFinite`] if it overflowed (e.g. δ near the smallest
+/// positive f64, or a range near f64::MAX): never returned as `+∞`.
+fn finite_width(w: f64) -> Result<f64, EstimatorError> {
+    if w.is_finite() {
+        Ok(w)
+    } else {
+        Err(EstimatorError::NonFinite {
+            what: "confidence width",
+        })
+    }
 }
 
 /// The variance-independent parts of a width, computed once per call.
@@ -129,10 +141,10 @@ impl Factors {
             },
             Width::Hoeffding { range } => Factors {
                 scale: 0.0,
-                offset: check_range(range)? * ((2.0 / delta).ln() / (2.0 * nf)).sqrt(),
+                offset: check_range(range)? * ((std::f64::consts::LN_2 - delta.ln()) / (2.0 * nf)).sqrt(),
             },
             Width::EmpiricalBernstein { range } => {
-                let log_term = (4.0 / delta).ln();
+                let log_term = 2.0 * std::f64::consts::LN_2 - delta.ln();
                 Factors {
                     scale: (2.0 * log_term / nf).sqrt(),
                     offset: 7.0 * check_range(range)? * log_term / (3.0 * (nf - 1.0)),
@@ -270,7 +282,7 @@ impl Estimate {
             };
             eps = eps.max(*o);
         }
-        Ok(eps)
+        finite_width(eps)
     }
 
     /// Writes the confidence interval `[lower_i, upper_i]` of every component (Sec 4.5):
@@ -380,6 +392,7 @@ impl Estimate {
                 .iter()
                 .fold(0.0f64, |e, v| e.max(f.width(*v)))
         };
+        let eps = finite_width(eps)?;
         Ok(Confidence {
             norm_inf: self.norm_inf(),
             eps,

@@ -183,11 +183,12 @@ pub(crate) fn validate(batch: &Batch, min_n: usize) -> Result<(), EstimatorError
         0,
         batch.dim_v % batch.dim_w,
     )?;
-    let steps = batch.n * batch.horizon;
+    // Saturating: a shape whose size overflows can match no vector length.
+    let steps = batch.n.saturating_mul(batch.horizon);
     mismatch("sigma", batch.dim_w, batch.sigma.len())?;
     mismatch("disc_rewards", steps, batch.disc_rewards.len())?;
-    mismatch("cum_score_v", steps * batch.dim_v, batch.cum_score_v.len())?;
-    mismatch("cum_score_w", steps * batch.dim_w, batch.cum_score_w.len())?;
+    mismatch("cum_score_v", steps.saturating_mul(batch.dim_v), batch.cum_score_v.len())?;
+    mismatch("cum_score_w", steps.saturating_mul(batch.dim_w), batch.cum_score_w.len())?;
     mismatch("lengths", batch.n, batch.lengths.len())?;
     if let Some(&len) = batch.lengths.iter().find(|&&l| l > batch.horizon) {
         return Err(EstimatorError::DimensionMismatch {

@@ -32,6 +32,15 @@ pub enum QuantileError {
         /// The offending degrees of freedom.
         nu: f64,
     },
+    /// The quantile is beyond the f64 range (a tail probability near the smallest positive
+    /// f64 with few degrees of freedom).
+    #[error("the quantile at p = {p} with {nu} degrees of freedom overflows f64")]
+    Overflow {
+        /// The probability.
+        p: f64,
+        /// The degrees of freedom.
+        nu: f64,
+    },
 }
 
 /// Degrees of freedom from which the asymptotic expansion replaces the Newton iteration.
@@ -143,6 +152,9 @@ pub fn student_t_quantile(p: f64, nu: f64) -> Result<f64, QuantileError> {
     } else {
         newton_upper(s.q, s.c, nu)
     };
+    if !t.is_finite() {
+        return Err(QuantileError::Overflow { p, nu });
+    }
     Ok(s.sign * t)
 }
 

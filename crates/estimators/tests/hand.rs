@@ -285,3 +285,32 @@ fn invalid_batches_are_typed_errors() {
         Err(EstimatorError::DimensionMismatch { .. })
     ));
 }
+
+/// Inputs found by the fuzz campaign (docs/RELIABILITY.md): each overflowed to ±∞ or panicked
+/// before; each is now a typed error.
+#[test]
+fn overflowing_inputs_are_typed_errors() {
+    use sepg_estimators::{QuantileError, Width, student_t_quantile, width};
+    // A δ near the smallest positive f64 with a huge variance or range.
+    let eb = Width::EmpiricalBernstein { range: 1e16 };
+    assert!(width(eb, 93.35546875, 3, 2.2250738585072014e-308).is_ok_and(f64::is_finite));
+    assert!(matches!(
+        width(Width::Chebyshev, 1e308, 2, 5e-324),
+        Err(EstimatorError::NonFinite { .. })
+    ));
+    let huge = Width::EmpiricalBernstein { range: 1e308 };
+    assert!(matches!(width(huge, 1.0, 2, 0.5), Err(EstimatorError::NonFinite { .. })));
+    // The Cauchy quantile at the smallest positive probability is beyond f64.
+    assert!(matches!(
+        student_t_quantile(5e-324, 1.0),
+        Err(QuantileError::Overflow { .. })
+    ));
+    // A batch whose shape overflows usize matches no buffer.
+    let mut b = Batch::zeros(0, 4, 1, 1, 0.9);
+    b.n = 1 << 63;
+    let mut est = Estimate::new();
+    assert!(matches!(
+        Estimator::new().value(&b, &mut est),
+        Err(EstimatorError::DimensionMismatch { .. })
+    ));
+}
