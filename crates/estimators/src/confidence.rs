@@ -141,7 +141,8 @@ impl Factors {
             },
             Width::Hoeffding { range } => Factors {
                 scale: 0.0,
-                offset: check_range(range)? * ((std::f64::consts::LN_2 - delta.ln()) / (2.0 * nf)).sqrt(),
+                offset: check_range(range)?
+                    * ((std::f64::consts::LN_2 - delta.ln()) / (2.0 * nf)).sqrt(),
             },
             Width::EmpiricalBernstein { range } => {
                 let log_term = 2.0 * std::f64::consts::LN_2 - delta.ln();

@@ -187,8 +187,16 @@ pub(crate) fn validate(batch: &Batch, min_n: usize) -> Result<(), EstimatorError
     let steps = batch.n.saturating_mul(batch.horizon);
     mismatch("sigma", batch.dim_w, batch.sigma.len())?;
     mismatch("disc_rewards", steps, batch.disc_rewards.len())?;
-    mismatch("cum_score_v", steps.saturating_mul(batch.dim_v), batch.cum_score_v.len())?;
-    mismatch("cum_score_w", steps.saturating_mul(batch.dim_w), batch.cum_score_w.len())?;
+    mismatch(
+        "cum_score_v",
+        steps.saturating_mul(batch.dim_v),
+        batch.cum_score_v.len(),
+    )?;
+    mismatch(
+        "cum_score_w",
+        steps.saturating_mul(batch.dim_w),
+        batch.cum_score_w.len(),
+    )?;
     mismatch("lengths", batch.n, batch.lengths.len())?;
     if let Some(&len) = batch.lengths.iter().find(|&&l| l > batch.horizon) {
         return Err(EstimatorError::DimensionMismatch {

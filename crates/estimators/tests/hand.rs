@@ -299,7 +299,10 @@ fn overflowing_inputs_are_typed_errors() {
         Err(EstimatorError::NonFinite { .. })
     ));
     let huge = Width::EmpiricalBernstein { range: 1e308 };
-    assert!(matches!(width(huge, 1.0, 2, 0.5), Err(EstimatorError::NonFinite { .. })));
+    assert!(matches!(
+        width(huge, 1.0, 2, 0.5),
+        Err(EstimatorError::NonFinite { .. })
+    ));
     // The Cauchy quantile at the smallest positive probability is beyond f64.
     assert!(matches!(
         student_t_quantile(5e-324, 1.0),
