@@ -373,3 +373,29 @@ fn estimate_is_reproducible_and_rejects_bad_input() {
         assert!(line.starts_with("sepg: error:"), "{args:?}: {line}");
     }
 }
+
+/// Output files are written atomically with the permissions of an ordinary file (0644 less
+/// the umask), not the 0600 of a private temporary file.
+#[cfg(unix)]
+#[test]
+fn report_files_have_ordinary_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let report = dir.path().join("report.md");
+    let out = sepg(&[
+        "verify",
+        "--quick",
+        "--quiet",
+        "--check",
+        "thm-3.3",
+        "--out",
+        report.to_str().expect("utf-8 path"),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let reference = dir.path().join("reference");
+    std::fs::write(&reference, b"x").expect("write");
+    let mode = |p: &std::path::Path| std::fs::metadata(p).expect("metadata").permissions().mode();
+    assert_eq!(mode(&report) & 0o777, mode(&reference) & 0o644);
+    let text = std::fs::read_to_string(&report).expect("report");
+    assert!(text.contains("thm-3.3-performance-difference"));
+}
