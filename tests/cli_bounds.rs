@@ -3,7 +3,7 @@
 
 use std::f64::consts::PI;
 
-use crate::common::{assert_usage_error, close, json_ok, sepg};
+use crate::common::{assert_usage_error, close, get, json_ok, sepg};
 
 const BASE: [&str; 10] = [
     "bounds",
@@ -24,12 +24,6 @@ fn run_json(extra: &[&str]) -> serde_json::Value {
     args.extend_from_slice(extra);
     args.push("--json");
     json_ok(&sepg(&args))
-}
-
-fn get(v: &serde_json::Value, key: &str) -> f64 {
-    v[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
 }
 
 /// c and d of Theorems 4.2 and 4.3 written out again from the printed formulas.

@@ -1,13 +1,7 @@
 //! `sepg exact` and `sepg replay`: values against formulas derived here independently, and the
 //! bad-input contract.
 
-use crate::common::{assert_usage_error, close, json_ok, sepg};
-
-fn get(v: &serde_json::Value, key: &str) -> f64 {
-    v[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("key {key} missing in {v}"))
-}
+use crate::common::{assert_usage_error, close, get, json_ok, sepg};
 
 /// Unclipped scalar LQG, infinite horizon, policy a ~ N(v s, σ²), s' = s + a, reward
 /// −(q s² + r a²), s₀ ~ U[−b, b]: the value is −P s² − K with

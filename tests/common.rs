@@ -46,3 +46,10 @@ pub fn json_ok(out: &Output) -> serde_json::Value {
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
 }
+
+/// The number under `key` of a JSON object, panicking with the object if it is missing.
+pub fn get(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
+}
