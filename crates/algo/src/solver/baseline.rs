@@ -7,6 +7,7 @@ use crate::core::error::RunError;
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
+use sepg_bounds::budget::Budget;
 use sepg_bounds::constants::TaskConstants;
 
 use crate::solver::source::{GradientSource, Need, Query};
@@ -90,10 +91,16 @@ pub(crate) fn iterate(
             iteration: t,
         });
     }
-    let mut budget = state.budget;
-    if let Some(p) = state.pending {
-        budget += e.j - p;
-    }
+    // The budget B (Definition 4.3) of the comparison algorithms is logged, never used.
+    let budget = match state.pending {
+        Some(p) => Budget::new(state.budget, p, None)
+            .and_then(|mut b| b.record_exploratory(e.j).map(|_| b.value()))
+            .map_err(|_| RunError::NonFinite {
+                what: "budget",
+                iteration: t,
+            })?,
+        None => state.budget,
+    };
     let record = Record {
         iteration: t,
         v: state.v.clone(),

@@ -4,7 +4,7 @@ use crate::core::error::RunError;
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
-use sepg_bounds::budget::split_requirement;
+use sepg_bounds::budget::{Budget, split_requirement};
 use sepg_bounds::constants::TaskConstants;
 
 use crate::solver::source::{Estimate, GradientSource, Need, Query};
@@ -67,7 +67,10 @@ pub(crate) fn iterate(
 ) -> Result<Record, RunError> {
     let t = state.iteration;
     let sizes = split(n, req.blocks());
-    let mut budget = state.budget;
+    let budget_error = |_| RunError::NonFinite {
+        what: "budget",
+        iteration: t,
+    };
     let mut j0 = state.j0;
     let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
     let w_dir = Need {
@@ -99,9 +102,16 @@ pub(crate) fn iterate(
     env_steps += ev.steps;
     let j_t = ev.j;
     let j_base = *j0.get_or_insert(j_t);
-    // Delayed w-budget update of the previous iteration (Sec 4.4.4).
-    if let Some(p) = state.pending {
-        budget += j_t - p;
+    // The budget B (Definition 4.3) measures differences from the last J of each tracked
+    // policy; the delayed w-budget update of the previous iteration comes first (Sec 4.4.4).
+    let mut budget = Budget::new(
+        state.budget,
+        state.pending.unwrap_or(j_t),
+        state.target_prev,
+    )
+    .map_err(budget_error)?;
+    if state.pending.is_some() {
+        budget.record_exploratory(j_t).map_err(budget_error)?;
     }
 
     let sigmas = state.sigma();
@@ -117,8 +127,8 @@ pub(crate) fn iterate(
     .map_err(|e| RunError::Bounds(e.to_string()))?;
     let required_v = match (type_one, sim_nu) {
         (Some((cv, _)), _) => cv,
-        (None, Some(nu)) => -nu * budget,
-        (None, None) => -budget,
+        (None, Some(nu)) => -nu * budget.value(),
+        (None, None) => budget.required_improvement(),
     };
     let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
         "the v-block returned no gradient".into(),
@@ -140,7 +150,8 @@ pub(crate) fn iterate(
                 "the v-block returned no w-gradient".into(),
             ))?;
             let mut wt = state.w.clone();
-            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, -budget)? {
+            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, budget.required_improvement())?
+            {
                 wt[h] += dw;
             }
             Some(wt)
@@ -158,15 +169,15 @@ pub(crate) fn iterate(
         trajectories += et.trajectories;
         env_steps += et.steps;
         j_target = et.j;
-        if let Some(prev) = state.target_prev {
-            budget += j_target - prev;
+        if state.target_prev.is_some() {
+            budget.record_target(j_target).map_err(budget_error)?;
         }
     }
 
     // w-block.
     let mut w_new = state.w.clone();
     let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
-        let required_w = -(1.0 - nu) * budget;
+        let required_w = -(1.0 - nu) * budget.value();
         let plan = w_plan(k, &sigmas, &ev, required_w, naive_w)?;
         apply(&mut w_new, &plan);
         (None, required_w, BlockLog::from_plan(&plan), j_t)
@@ -182,8 +193,8 @@ pub(crate) fn iterate(
         trajectories += ew.trajectories;
         env_steps += ew.steps;
         // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
-        budget += ew.j - j_t;
-        let required_w = type_one.map_or(-budget, |(_, cw)| cw);
+        budget.record_exploratory(ew.j).map_err(budget_error)?;
+        let required_w = type_one.map_or(budget.required_improvement(), |(_, cw)| cw);
         let plan = w_plan(k, &sigmas, &ew, required_w, naive_w)?;
         apply(&mut w_new, &plan);
         (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
@@ -192,12 +203,6 @@ pub(crate) fn iterate(
     if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
         return Err(RunError::NonFinite {
             what: "policy parameters",
-            iteration: t,
-        });
-    }
-    if !budget.is_finite() {
-        return Err(RunError::NonFinite {
-            what: "budget",
             iteration: t,
         });
     }
@@ -211,7 +216,7 @@ pub(crate) fn iterate(
         j_after_v,
         j_target,
         w_target,
-        budget,
+        budget: budget.value(),
         required_v: Some(required_v),
         required_w: Some(required_w),
         alpha: v_log.size,
@@ -230,7 +235,7 @@ pub(crate) fn iterate(
     state.iteration += 1;
     state.v = v_new;
     state.w = w_new;
-    state.budget = budget;
+    state.budget = budget.value();
     state.j0 = j0;
     state.pending = Some(pending);
     if matches!(
