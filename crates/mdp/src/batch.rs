@@ -101,3 +101,288 @@ impl Batch {
         self.lengths.iter().sum()
     }
 }
+
+/// Errors of [`Batch::from_steps`]: arrays that cannot describe a batch of trajectories.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BatchError {
+    /// `n = 0` trajectories or `horizon = 0`.
+    #[error("a batch needs n ≥ 1 trajectories and horizon ≥ 1 (got n = {n}, horizon = {horizon})")]
+    Empty {
+        /// Number of trajectories (length of `lengths`).
+        n: usize,
+        /// Horizon.
+        horizon: usize,
+    },
+    /// An array does not have the length its shape requires.
+    #[error("{what} has length {got}, expected {expected}")]
+    Length {
+        /// Which array.
+        what: &'static str,
+        /// Length implied by `n`, `horizon` and the dimensions.
+        expected: usize,
+        /// Length given.
+        got: usize,
+    },
+    /// A trajectory length is 0 or exceeds the horizon.
+    #[error("trajectory {index} has length {len}, outside 1..={horizon}")]
+    TrajectoryLength {
+        /// Trajectory index.
+        index: usize,
+        /// Its length.
+        len: usize,
+        /// The horizon.
+        horizon: usize,
+    },
+    /// γ is not in [0, 1].
+    #[error("discount factor gamma = {gamma} is not in [0, 1]")]
+    Gamma {
+        /// The value given.
+        gamma: f64,
+    },
+    /// A standard deviation is not finite and positive.
+    #[error("standard deviation sigma[{index}] = {value} is not finite and positive")]
+    Sigma {
+        /// Action dimension.
+        index: usize,
+        /// The value given.
+        value: f64,
+    },
+    /// A reward or score of a taken step, or a cumulative sum of them, is not finite.
+    #[error("{what} of trajectory {index} is not finite")]
+    NonFinite {
+        /// `"reward"`, `"v-score"` or `"w-score"`.
+        what: &'static str,
+        /// Trajectory index.
+        index: usize,
+    },
+}
+
+impl Batch {
+    /// A batch from per-step data collected by any rollout loop (for example a Python
+    /// environment): the raw rewards `r_t` and the per-step scores `∇_v log π(a_t|s_t)`,
+    /// `∇_w log π(a_t|s_t)` of `n = lengths.len()` trajectories, each stored over `horizon`
+    /// steps (values at `t ≥ len_i` are ignored). The rewards are discounted and the scores
+    /// accumulated as the rollout engine does (Sec 2.3.1), with the padding of the module
+    /// documentation.
+    ///
+    /// Shapes (row-major, trajectory first): `rewards` is `n · horizon`, `score_v` is
+    /// `n · horizon · dim_v`, `score_w` is `n · horizon · dim_w` with `dim_w = sigma.len()`;
+    /// `dim_v` is read off the length of `score_v`. A batch that only estimates `J` (no
+    /// gradients) passes empty `sigma`, `score_v` and `score_w`.
+    ///
+    /// # Formula
+    /// ```text
+    /// disc_rewards[i, t] = γ^t r_t                      (0 for t ≥ len_i)
+    /// cum_score[i, t]    = Σ_{k ≤ min(t, len_i − 1)} score_k
+    /// ```
+    ///
+    /// # Errors
+    /// A [`BatchError`] for an empty batch, inconsistent lengths, a trajectory length outside
+    /// `1..=horizon`, γ ∉ [0, 1], σ not finite and positive, or a non-finite reward, score or
+    /// cumulative sum within the taken steps.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_mdp::Batch;
+    /// // Two trajectories, horizon 2, one mean and one variance parameter; the second stops
+    /// // after one step.
+    /// let b = Batch::from_steps(2, 0.5, &[1.0], &[1.0, 2.0, 3.0, 9.0],
+    ///     &[0.1, 0.2, 0.3, 9.0], &[1.0, -1.0, 0.5, 9.0], &[2, 1]).unwrap();
+    /// assert_eq!(b.disc_rewards, vec![1.0, 1.0, 3.0, 0.0]);
+    /// assert_eq!(b.cum_score_v, vec![0.1, 0.1 + 0.2, 0.3, 0.3]);
+    /// assert_eq!(b.cum_score_w, vec![1.0, 0.0, 0.5, 0.5]);
+    /// assert_eq!(b.steps(), 3);
+    /// ```
+    pub fn from_steps(
+        horizon: usize,
+        gamma: f64,
+        sigma: &[f64],
+        rewards: &[f64],
+        score_v: &[f64],
+        score_w: &[f64],
+        lengths: &[usize],
+    ) -> Result<Batch, BatchError> {
+        let n = lengths.len();
+        if n == 0 || horizon == 0 {
+            return Err(BatchError::Empty { n, horizon });
+        }
+        if !(0.0..=1.0).contains(&gamma) {
+            return Err(BatchError::Gamma { gamma });
+        }
+        if let Some((index, &value)) = sigma
+            .iter()
+            .enumerate()
+            .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+        {
+            return Err(BatchError::Sigma { index, value });
+        }
+        let cells = n.saturating_mul(horizon);
+        let dim_v = score_v.len() / cells;
+        let dim_w = sigma.len();
+        for (what, expected, got) in [
+            ("rewards", cells, rewards.len()),
+            ("score_v", cells.saturating_mul(dim_v), score_v.len()),
+            ("score_w", cells.saturating_mul(dim_w), score_w.len()),
+        ] {
+            if expected != got {
+                return Err(BatchError::Length {
+                    what,
+                    expected,
+                    got,
+                });
+            }
+        }
+        let mut batch = Batch::zeros(n, horizon, dim_v, dim_w, gamma);
+        batch.sigma.copy_from_slice(sigma);
+        for (index, &len) in lengths.iter().enumerate() {
+            if len == 0 || len > horizon {
+                return Err(BatchError::TrajectoryLength {
+                    index,
+                    len,
+                    horizon,
+                });
+            }
+            batch.lengths[index] = len;
+            let row = index * horizon;
+            let mut disc = 1.0;
+            for t in 0..len {
+                batch.disc_rewards[row + t] = disc * rewards[row + t];
+                disc *= gamma;
+            }
+            accumulate(&mut batch.cum_score_v, score_v, row, len, horizon, dim_v);
+            accumulate(&mut batch.cum_score_w, score_w, row, len, horizon, dim_w);
+            let finite = |xs: &[f64], d: usize| {
+                xs[row * d..(row + horizon) * d]
+                    .iter()
+                    .all(|x| x.is_finite())
+            };
+            for (what, ok) in [
+                ("reward", finite(&batch.disc_rewards, 1)),
+                ("v-score", finite(&batch.cum_score_v, dim_v)),
+                ("w-score", finite(&batch.cum_score_w, dim_w)),
+            ] {
+                if !ok {
+                    return Err(BatchError::NonFinite { what, index });
+                }
+            }
+        }
+        Ok(batch)
+    }
+}
+
+/// Running sums of the `dim`-vectors `steps[row + t]` for `t < len` into `cum`, the last sum
+/// repeated for `len ≤ t < horizon`.
+fn accumulate(cum: &mut [f64], steps: &[f64], row: usize, len: usize, horizon: usize, dim: usize) {
+    if dim == 0 {
+        return;
+    }
+    let mut acc = vec![0.0; dim];
+    for t in 0..horizon {
+        if t < len {
+            let o = (row + t) * dim;
+            for (a, s) in acc.iter_mut().zip(&steps[o..o + dim]) {
+                *a += s;
+            }
+        }
+        let o = (row + t) * dim;
+        cum[o..o + dim].copy_from_slice(&acc);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values after a trajectory's end are ignored (even NaN), γ^t is applied from t = 0,
+    /// and the cumulative scores are running sums padded with their last value.
+    #[test]
+    fn from_steps_discounts_accumulates_and_pads() {
+        let nan = f64::NAN;
+        let b = Batch::from_steps(
+            3,
+            0.5,
+            &[2.0],
+            &[4.0, 4.0, 4.0, 1.0, nan, nan],
+            &[1.0, 2.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, nan, nan, nan, nan],
+            &[1.0, 1.0, 1.0, -1.0, nan, nan],
+            &[3, 1],
+        )
+        .expect("batch");
+        assert_eq!(
+            (b.n, b.dim_v, b.dim_w, b.sigma.clone()),
+            (2, 2, 1, vec![2.0])
+        );
+        assert_eq!(b.disc_rewards, vec![4.0, 2.0, 1.0, 1.0, 0.0, 0.0]);
+        assert_eq!(
+            b.cum_score_v,
+            vec![1.0, 2.0, 2.0, 4.0, 5.0, 8.0, 5.0, 6.0, 5.0, 6.0, 5.0, 6.0]
+        );
+        assert_eq!(b.cum_score_w, vec![1.0, 2.0, 3.0, -1.0, -1.0, -1.0]);
+        assert_eq!(b.lengths, vec![3, 1]);
+    }
+
+    #[test]
+    fn from_steps_rejects_bad_input_with_typed_errors() {
+        let ok = |r: &[f64], sv: &[f64], sigma: &[f64], gamma, lengths: &[usize]| {
+            Batch::from_steps(
+                2,
+                gamma,
+                sigma,
+                r,
+                sv,
+                &[0.0; 2][..sigma.len() * 2],
+                lengths,
+            )
+        };
+        assert!(ok(&[1.0, 1.0], &[0.0, 0.0], &[1.0], 0.9, &[2]).is_ok());
+        assert!(matches!(
+            ok(&[], &[], &[], 0.9, &[]),
+            Err(BatchError::Empty { n: 0, .. })
+        ));
+        assert!(matches!(
+            ok(&[1.0], &[], &[], 0.9, &[2]),
+            Err(BatchError::Length {
+                what: "rewards",
+                ..
+            })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[0.0, 0.0, 0.0], &[1.0], 0.9, &[2]),
+            Err(BatchError::Length {
+                what: "score_v",
+                ..
+            })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[], &[], 0.9, &[3]),
+            Err(BatchError::TrajectoryLength { len: 3, .. })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[], &[], 0.9, &[0]),
+            Err(BatchError::TrajectoryLength { len: 0, .. })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[], &[], f64::NAN, &[2]),
+            Err(BatchError::Gamma { .. })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[0.0, 0.0], &[0.0], 0.9, &[2]),
+            Err(BatchError::Sigma { index: 0, .. })
+        ));
+        assert!(matches!(
+            ok(&[1.0, f64::INFINITY], &[], &[], 0.9, &[2]),
+            Err(BatchError::NonFinite {
+                what: "reward",
+                index: 0
+            })
+        ));
+        assert!(matches!(
+            ok(&[1.0, 1.0], &[f64::MAX, f64::MAX], &[1.0], 0.9, &[2]),
+            Err(BatchError::NonFinite {
+                what: "v-score",
+                index: 0
+            })
+        ));
+    }
+}

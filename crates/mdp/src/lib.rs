@@ -20,7 +20,7 @@ pub mod policy;
 pub mod rng;
 pub mod rollout;
 
-pub use batch::Batch;
+pub use batch::{Batch, BatchError};
 pub use env::{AnyEnv, EnvConstants, EnvError, Environment, LqgEnv, Preset};
 pub use lqg_model::{BoxBounds, LqgModel, ModelError};
 pub use mountain_car::MountainCar;

@@ -143,7 +143,7 @@ impl Algorithm {
         }
     }
 
-    fn validate(self) -> Result<(), ConfigError> {
+    pub(crate) fn validate(self) -> Result<(), ConfigError> {
         let hp = |name, value: f64, ok: bool, domain| {
             if ok && value.is_finite() {
                 Ok(())
@@ -309,20 +309,7 @@ impl SepgConfig {
         }
         match self.gradient {
             GradientMode::Sampled { delta } => {
-                if !(delta > 0.0 && delta < 1.0) {
-                    return Err(ConfigError::InvalidDelta { delta });
-                }
-                let blocks = self.algorithm.blocks();
-                let min = match self.algorithm {
-                    Algorithm::Sepg(_) => 4,
-                    _ => 2,
-                };
-                if self.n_trajectories / blocks < min {
-                    return Err(ConfigError::TooFewTrajectories {
-                        n: self.n_trajectories,
-                        blocks,
-                    });
-                }
+                check_sampled(self.algorithm, self.n_trajectories, delta)?;
             }
             GradientMode::Exact => {
                 let unsupported = match &self.env {
@@ -383,4 +370,28 @@ impl CheckedConfig {
             self.inner.initial_budget,
         )
     }
+}
+
+/// Checks the sampled-mode settings: δ ∈ (0, 1) and N large enough to give every block at
+/// least 2 trajectories (4 for a block that estimates ∇_w L, cross-fitted on two halves).
+pub(crate) fn check_sampled(
+    algorithm: Algorithm,
+    n_trajectories: usize,
+    delta: f64,
+) -> Result<(), ConfigError> {
+    if !(delta > 0.0 && delta < 1.0) {
+        return Err(ConfigError::InvalidDelta { delta });
+    }
+    let blocks = algorithm.blocks();
+    let min = match algorithm {
+        Algorithm::Sepg(_) => 4,
+        _ => 2,
+    };
+    if n_trajectories / blocks < min {
+        return Err(ConfigError::TooFewTrajectories {
+            n: n_trajectories,
+            blocks,
+        });
+    }
+    Ok(())
 }

@@ -21,22 +21,23 @@
 //! ```
 pub(crate) mod baseline;
 pub(crate) mod exact;
-pub(crate) mod sampled;
+pub mod sampled;
 pub(crate) mod sepg;
-pub(crate) mod source;
-pub(crate) mod steps;
+pub mod source;
+pub mod steps;
 
 use sepg_bounds::constants::TaskConstants;
+use sepg_estimators::GradientSpec;
 use sepg_mdp::env::AnyEnv;
 use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 
-use crate::core::config::{Algorithm, CheckedConfig, GradientMode};
+use crate::core::config::{Algorithm, CheckedConfig, GradientMode, check_sampled};
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
 use crate::core::record::Record;
 use crate::core::state::State;
 use crate::solver::exact::ExactSource;
-use crate::solver::sampled::SampledSource;
+use crate::solver::sampled::{BatchCollector, BlockEstimator, CollectedSource, SampledSource};
 use crate::solver::source::GradientSource;
 
 /// Every algorithm of the crate as a [`Solver`], built from a [`CheckedConfig`].
@@ -106,6 +107,69 @@ impl PolicySolver {
             dims: (cfg.v0.len(), cfg.sigma0.len()),
             constants,
             source,
+        })
+    }
+}
+
+/// The settings of a run whose trajectories are collected outside the crate by a
+/// [`BatchCollector`] (any environment, any language): what [`CheckedConfig`] takes from the
+/// environment is given here directly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CollectedConfig {
+    /// The algorithm.
+    pub algorithm: Algorithm,
+    /// The task constants R, M_φ, |A|, γ of the environment (validated).
+    pub constants: TaskConstants,
+    /// Confidence parameter δ ∈ (0, 1) of the widths (Sec 4.5).
+    pub delta: f64,
+    /// Estimator of ∇_v J and ∇_w J.
+    pub estimator: GradientSpec,
+    /// Trajectories per iteration N, split evenly among the blocks.
+    pub n_trajectories: usize,
+    /// Seed of the run: the seed keys of the requests derive from (seed, iteration, block).
+    pub seed: u64,
+    /// Number of action dimensions l.
+    pub actions: usize,
+    /// Number of features p (the mean has `l · p` parameters).
+    pub features: usize,
+}
+
+impl PolicySolver {
+    /// The solver of `config` with every batch collected by `collector` and estimated by
+    /// [`BlockEstimator`]: the same iteration code as [`PolicySolver::new`] in the sampled
+    /// mode, so a collector that reproduces the built-in rollouts reproduces their records.
+    ///
+    /// # Errors
+    /// A [`ConfigError`] for bad hyper-parameters, δ ∉ (0, 1), N too small for the blocks, or
+    /// zero dimensions.
+    pub fn with_collector(
+        config: &CollectedConfig,
+        collector: Box<dyn BatchCollector>,
+    ) -> Result<Self, ConfigError> {
+        config.algorithm.validate()?;
+        check_sampled(config.algorithm, config.n_trajectories, config.delta)?;
+        for (what, got) in [("actions", config.actions), ("features", config.features)] {
+            if got == 0 {
+                return Err(ConfigError::DimensionMismatch {
+                    what,
+                    expected: 1,
+                    got,
+                });
+            }
+        }
+        let dims = (config.actions * config.features, config.actions);
+        let estimator = BlockEstimator::new(config.delta, config.estimator, config.constants);
+        Ok(PolicySolver {
+            algorithm: config.algorithm,
+            n: config.n_trajectories,
+            dims,
+            constants: config.constants,
+            source: Box::new(CollectedSource::new(
+                collector,
+                config.seed,
+                dims,
+                estimator,
+            )),
         })
     }
 }

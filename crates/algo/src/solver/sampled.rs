@@ -7,10 +7,12 @@ use sepg_estimators::{
 use sepg_mdp::Batch;
 use sepg_mdp::env::{AnyEnv, Environment};
 use sepg_mdp::policy::GaussianPolicy;
+use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::{rollout_into, rollout_returns_into};
 
 use crate::core::error::RunError;
-use crate::solver::source::{Estimate as BlockEstimate, Grad, GradientSource, Query};
+use crate::core::seed::Block;
+use crate::solver::source::{Estimate as BlockEstimate, Grad, GradientSource, Need, Query};
 
 fn ee(e: sepg_estimators::EstimatorError) -> RunError {
     RunError::Estimator(e.to_string())
@@ -26,16 +28,34 @@ pub(crate) struct SampledSource {
     env: AnyEnv,
     horizon: usize,
     seed: u64,
+    batch: Batch,
+    returns: Vec<f64>,
+    estimator: BlockEstimator,
+}
+
+/// The estimates of one block from its batch of trajectories: Ĵ, the requested gradients
+/// (G(PO)MDP or the estimator of the configuration, Appendix B) and their Student-t
+/// half-widths ε_i at level δ (Sec 4.5, eq. 4.22). Every sampled block of every algorithm
+/// goes through [`BlockEstimator::estimate`], whether the batch comes from the built-in
+/// rollout engine or from a [`BatchCollector`]. Buffers are reused across calls.
+pub struct BlockEstimator {
     spec: GradientSpec,
     constants: TaskConstants,
     estimator: Estimator,
-    batch: Batch,
     value: Estimate,
     grad: Estimate,
     surrogate: SurrogateEstimate,
-    returns: Vec<f64>,
     dc: Vec<f64>,
     widths: StudentT,
+}
+
+impl std::fmt::Debug for BlockEstimator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BlockEstimator")
+            .field("spec", &self.spec)
+            .field("delta", &self.widths.delta)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The Student-t width factors `t(1 − δ/2, n − 1)/√n` of the sample sizes seen so far.
@@ -97,14 +117,24 @@ impl SampledSource {
             env,
             horizon,
             seed,
+            batch: Batch::zeros(0, 0, 0, 0, 0.0),
+            returns: Vec::new(),
+            estimator: BlockEstimator::new(delta, spec, constants),
+        }
+    }
+}
+
+impl BlockEstimator {
+    /// An estimator with confidence parameter `delta` ∈ (0, 1) for the widths, gradient
+    /// estimator `spec` and the task constants that define c(σ) in ∇_w L (Corollary 4.4).
+    pub fn new(delta: f64, spec: GradientSpec, constants: TaskConstants) -> Self {
+        BlockEstimator {
             spec,
             constants,
             estimator: Estimator::new(),
-            batch: Batch::zeros(0, 0, 0, 0, 0.0),
             value: Estimate::new(),
             grad: Estimate::new(),
             surrogate: SurrogateEstimate::new(),
-            returns: Vec::new(),
             dc: Vec::new(),
             widths: StudentT {
                 delta,
@@ -113,11 +143,61 @@ impl SampledSource {
         }
     }
 
-    /// ∇̂_w L for every action dimension of the current batch, with L defined with c at
+    /// Ĵ and the gradients `need` asks for, from `batch`.
+    ///
+    /// # Formula
+    /// ```text
+    /// Ĵ = mean_i Σ_t γ^t r_t,   ε_i = t(1 − δ/2, N − 1) · √(Var_i / N)
+    /// ```
+    ///
+    /// # Errors
+    /// [`RunError::Estimator`] when the batch is too small (fewer than 2 trajectories for a
+    /// gradient, 4 for ∇_w L) or has the wrong dimensions; [`RunError::Bounds`] when c(σ)
+    /// cannot be evaluated.
+    pub fn estimate(&mut self, batch: &Batch, need: Need) -> Result<BlockEstimate, RunError> {
+        if !(need.grad_v || need.grad_wj || need.grad_wl) {
+            let j = (0..batch.n)
+                .map(|i| batch.discounted_return(i))
+                .sum::<f64>()
+                / batch.n as f64;
+            return Ok(BlockEstimate {
+                j,
+                grad_v: None,
+                grad_wj: None,
+                grad_wl: None,
+                trajectories: batch.n as u64,
+                steps: batch.steps() as u64,
+            });
+        }
+        self.estimator.value(batch, &mut self.value).map_err(ee)?;
+        let j = self.value.mean()[0];
+        let mut grad = |param| -> Result<Grad, RunError> {
+            self.estimator
+                .gradient(batch, param, self.spec, &mut self.grad)
+                .map_err(ee)?;
+            self.widths.grad(&self.grad)
+        };
+        let grad_v = need.grad_v.then(|| grad(Param::V)).transpose()?;
+        let grad_wj = need.grad_wj.then(|| grad(Param::W)).transpose()?;
+        let grad_wl = need
+            .grad_wl
+            .then(|| self.surrogate_grad(batch))
+            .transpose()?;
+        Ok(BlockEstimate {
+            j,
+            grad_v,
+            grad_wj,
+            grad_wl,
+            trajectories: batch.n as u64,
+            steps: batch.steps() as u64,
+        })
+    }
+
+    /// ∇̂_w L for every action dimension of `batch`, with L defined with c at
     /// σ_min = min_j σ_j (the c of the v-update): ∂c/∂σ_j is c′(σ_min) for the (lowest)
     /// minimising j, else 0.
-    fn surrogate_grad(&mut self) -> Result<Grad, RunError> {
-        let sigmas = &self.batch.sigma;
+    fn surrogate_grad(&mut self, batch: &Batch) -> Result<Grad, RunError> {
+        let sigmas = &batch.sigma;
         let (jmin, smin) =
             sigmas
                 .iter()
@@ -134,7 +214,7 @@ impl SampledSource {
         self.dc
             .extend((0..sigmas.len()).map(|j| if j == jmin { dc_min } else { 0.0 }));
         self.estimator
-            .surrogate_gradient(&self.batch, self.spec, c, &self.dc, &mut self.surrogate)
+            .surrogate_gradient(batch, self.spec, c, &self.dc, &mut self.surrogate)
             .map_err(ee)?;
         self.widths.grad(self.surrogate.grad_w_l())
     }
@@ -176,27 +256,95 @@ impl GradientSource for SampledSource {
             });
         }
         rollout_into(&self.env, &policy, q.n, self.horizon, key, &mut self.batch).map_err(me)?;
-        self.estimator
-            .value(&self.batch, &mut self.value)
-            .map_err(ee)?;
-        let j = self.value.mean()[0];
-        let mut grad = |param| -> Result<Grad, RunError> {
-            self.estimator
-                .gradient(&self.batch, param, self.spec, &mut self.grad)
-                .map_err(ee)?;
-            self.widths.grad(&self.grad)
-        };
-        let grad_v = q.need.grad_v.then(|| grad(Param::V)).transpose()?;
-        let grad_wj = q.need.grad_wj.then(|| grad(Param::W)).transpose()?;
-        let grad_wl = q.need.grad_wl.then(|| self.surrogate_grad()).transpose()?;
-        Ok(BlockEstimate {
-            j,
-            grad_v,
-            grad_wj,
-            grad_wl,
-            trajectories: q.n as u64,
-            steps: self.batch.steps() as u64,
-        })
+        self.estimator.estimate(&self.batch, q.need)
+    }
+}
+
+/// What a [`BatchCollector`] must collect for one block of an iteration (Algorithm 4.3).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchRequest<'a> {
+    /// Iteration the block belongs to.
+    pub iteration: u64,
+    /// Which block.
+    pub block: Block,
+    /// The seed key of the block; trajectory `i` should draw from streams derived from
+    /// `key.trajectory_seed(i, ..)` so that a run is reproducible.
+    pub key: SeedKey,
+    /// Mean parameters v (action-major, `v[j · p + i]`).
+    pub v: &'a [f64],
+    /// Log standard deviations w, `None` for the deterministic policy (w = −∞).
+    pub w: Option<&'a [f64]>,
+    /// Number of trajectories to collect.
+    pub n: usize,
+    /// Whether the scores are needed; when `false`, only the rewards and lengths are used
+    /// (a batch without scores, see [`Batch::from_steps`], suffices).
+    pub scores: bool,
+}
+
+/// A provider of trajectory batches collected outside the crate (another language, another
+/// simulator): the policy N(v φ(s), diag σ²) of the request is run `n` times and the batch
+/// returned with raw rewards discounted and scores accumulated ([`Batch::from_steps`]).
+pub trait BatchCollector: Send {
+    /// Collects the batch of `request`.
+    ///
+    /// # Errors
+    /// Any [`RunError`]; it ends the iteration and leaves the state unchanged.
+    fn collect(&mut self, request: &BatchRequest<'_>) -> Result<Batch, RunError>;
+}
+
+/// A [`GradientSource`] fed by a [`BatchCollector`], estimating with [`BlockEstimator`].
+pub(crate) struct CollectedSource {
+    collector: Box<dyn BatchCollector>,
+    seed: u64,
+    dims: (usize, usize),
+    estimator: BlockEstimator,
+}
+
+impl CollectedSource {
+    pub(crate) fn new(
+        collector: Box<dyn BatchCollector>,
+        seed: u64,
+        dims: (usize, usize),
+        estimator: BlockEstimator,
+    ) -> Self {
+        CollectedSource {
+            collector,
+            seed,
+            dims,
+            estimator,
+        }
+    }
+}
+
+impl GradientSource for CollectedSource {
+    fn estimate(&mut self, q: &Query<'_>) -> Result<BlockEstimate, RunError> {
+        let scores = q.need.grad_v || q.need.grad_wj || q.need.grad_wl;
+        let batch = self.collector.collect(&BatchRequest {
+            iteration: q.iteration,
+            block: q.block,
+            key: q.block.key(self.seed, q.iteration),
+            v: q.v,
+            w: q.w,
+            n: q.n,
+            scores,
+        })?;
+        let dims = (batch.dim_v, batch.dim_w);
+        if batch.n != q.n || (scores && dims != self.dims) {
+            return Err(RunError::Mdp(format!(
+                "the collected batch has {} trajectories and dimensions {dims:?}, the request {} and {:?}",
+                batch.n, q.n, self.dims
+            )));
+        }
+        if let (true, Some(w)) = (scores, q.w) {
+            let expected = w.iter().map(|w| w.exp());
+            if !batch.sigma.iter().copied().eq(expected) {
+                return Err(RunError::Mdp(
+                    "the collected batch was generated with other standard deviations than the request's"
+                        .into(),
+                ));
+            }
+        }
+        self.estimator.estimate(&batch, q.need)
     }
 }
 
@@ -204,7 +352,6 @@ impl GradientSource for SampledSource {
 mod tests {
     use super::*;
     use sepg_estimators::Width;
-    use sepg_mdp::rng::SeedKey;
     use sepg_mdp::rollout::rollout;
 
     /// The memoised factors give the widths of `Estimate::widths_into` bit for bit, for
@@ -237,5 +384,96 @@ mod tests {
         }
         assert_eq!(widths.scales.len(), 4);
         assert!(widths.scale(1).is_err());
+    }
+
+    /// Replays the built-in rollouts as an outside collector would: scored blocks through
+    /// `rollout`, J-only blocks as one discounted return per trajectory.
+    struct Replay {
+        env: AnyEnv,
+        horizon: usize,
+        /// Added to the iteration of every key (0 replays the built-in streams).
+        shift: u64,
+    }
+
+    impl BatchCollector for Replay {
+        fn collect(&mut self, r: &BatchRequest<'_>) -> Result<Batch, RunError> {
+            let key = SeedKey::new(r.key.seed, r.key.iteration + self.shift, r.key.block);
+            let (p, l) = (self.env.feature_dim(), self.env.action_dim());
+            let policy = match r.w {
+                Some(w) => GaussianPolicy::new(r.v.to_vec(), w.to_vec(), p),
+                None => GaussianPolicy::deterministic(r.v.to_vec(), l, p),
+            }
+            .map_err(me)?;
+            if r.scores {
+                return rollout(&self.env, &policy, r.n, self.horizon, key).map_err(me);
+            }
+            let g = sepg_mdp::rollout::rollout_returns(&self.env, &policy, r.n, self.horizon, key)
+                .map_err(me)?;
+            let mut rewards = vec![0.0; r.n * self.horizon];
+            for (i, gi) in g.iter().enumerate() {
+                rewards[i * self.horizon] = *gi;
+            }
+            let lengths = vec![self.horizon; r.n];
+            Batch::from_steps(self.horizon, 1.0, &[], &rewards, &[], &[], &lengths).map_err(me)
+        }
+    }
+
+    /// Batches handed in through the collector API give the records of the built-in sampled
+    /// path bit for bit, for every algorithm family (the block logic is shared, not copied);
+    /// a collector drawing other streams (shift 1) gives different records.
+    #[test]
+    fn collected_batches_reproduce_the_sampled_records() {
+        use crate::core::config::{Algorithm, Requirement, SepgConfig};
+        use crate::core::executor::{Collect, Executor};
+        use crate::solver::{CollectedConfig, PolicySolver};
+        let algorithms = [
+            Algorithm::Sepg(Requirement::Mi),
+            Algorithm::Sepg(Requirement::LbI { nu: 0.5 }),
+            Algorithm::Sepg(Requirement::Lv),
+            Algorithm::Sepg(Requirement::Zv),
+            Algorithm::Sepg(Requirement::Sim { nu: 0.5 }),
+            Algorithm::SepgNaiveW(Requirement::Zv),
+            Algorithm::AdaStep,
+            Algorithm::adam(0.01, 0.01),
+        ];
+        let records = |solver: PolicySolver, state| {
+            let mut log = Collect::default();
+            let mut exec = Executor::new(solver, state).observe(&mut log);
+            exec.run(4).expect("run");
+            drop(exec);
+            log.records
+        };
+        for algorithm in algorithms {
+            let mut cfg = SepgConfig::new(sepg_mdp::env::Preset::Lqg1d.build(), algorithm);
+            cfg.n_trajectories = 60;
+            cfg.seed = 9;
+            let checked = cfg.clone().check().expect("config");
+            let built_in = records(
+                PolicySolver::new(&checked).expect("solver"),
+                checked.initial_state(),
+            );
+            let collected = |shift| {
+                let external = CollectedConfig {
+                    algorithm,
+                    constants: *checked.constants(),
+                    delta: 0.2,
+                    estimator: cfg.estimator,
+                    n_trajectories: cfg.n_trajectories,
+                    seed: cfg.seed,
+                    actions: 1,
+                    features: 1,
+                };
+                let replay = Replay {
+                    env: cfg.env.clone(),
+                    horizon: cfg.horizon,
+                    shift,
+                };
+                let solver = PolicySolver::with_collector(&external, Box::new(replay))
+                    .expect("collected solver");
+                records(solver, checked.initial_state())
+            };
+            assert_eq!(collected(0), built_in, "{algorithm:?}");
+            assert_ne!(collected(1), built_in, "{algorithm:?}");
+        }
     }
 }

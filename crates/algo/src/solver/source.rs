@@ -1,12 +1,12 @@
 //! Where J and its gradients come from: Monte Carlo estimates or exact oracles. The iteration
-//! logic is written once against [`GradientSource`].
+//! logic is written once against the crate-internal `GradientSource` trait.
 use crate::core::error::RunError;
 use crate::core::seed::Block;
 
 /// A gradient with its per-component confidence half-widths ε_i (Assumption 4.6); all
 /// widths are 0 for exact gradients.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Grad {
+pub struct Grad {
     /// The (estimated) gradient components.
     pub value: Vec<f64>,
     /// Half-widths ε_i, same length as `value`.
@@ -23,7 +23,7 @@ impl Grad {
 
 /// Which gradients a block needs besides J.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub(crate) struct Need {
+pub struct Need {
     /// ∇_v J.
     pub grad_v: bool,
     /// ∇_w J.
@@ -49,9 +49,9 @@ pub(crate) struct Query<'a> {
     pub need: Need,
 }
 
-/// The result of a [`Query`].
+/// What one block yields: J and the gradients it was asked for.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Estimate {
+pub struct Estimate {
     /// J(θ) (Ĵ, the mean discounted return, when sampled).
     pub j: f64,
     /// ∇_v J if requested.

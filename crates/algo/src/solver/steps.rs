@@ -2,7 +2,7 @@
 //!
 //! Exact gradients use Theorems 4.2, 4.3 and 4.5 directly; estimated gradients use their
 //! high-probability versions (Theorems 4.7–4.9) in the sign-aware form, which keeps the
-//! guarantee for steps against the estimated direction (SPEC §4, `HpForm::SignAware`).
+//! guarantee for steps against the estimated direction (`HpForm::SignAware`, docs/THEOREMS.md).
 use sepg_bounds::constants::{TaskConstants, c};
 use sepg_bounds::greedy::argmax_abs;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
@@ -30,7 +30,7 @@ fn eps_max(g: &Grad) -> f64 {
 
 /// A chosen greedy-coordinate step.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Step {
+pub struct Step {
     /// Coordinate that moves.
     pub index: usize,
     /// Step size (α or β).
@@ -47,7 +47,7 @@ pub(crate) struct Step {
 
 /// What an update block does.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Plan {
+pub enum Plan {
     /// Zero or sub-noise direction (eq. 4.23): no update.
     BelowNoise,
     /// Update one coordinate.
@@ -79,12 +79,7 @@ fn plan_from(
 
 /// The greedy-coordinate v-update with the largest safe ᾱ for `required` (Theorem 4.2,
 /// eq. 4.10; Theorem 4.7, eq. 4.26 when estimated).
-pub(crate) fn v_step(
-    k: &TaskConstants,
-    sigma: f64,
-    g: &Grad,
-    required: f64,
-) -> Result<Plan, RunError> {
+pub fn v_step(k: &TaskConstants, sigma: f64, g: &Grad, required: f64) -> Result<Plan, RunError> {
     let index = argmax_abs(&g.value).map_err(be)?;
     let dir = g.value[index];
     if is_exact(g) {
@@ -105,7 +100,7 @@ pub(crate) fn v_step(
 /// The greedy-coordinate w-update along ∇_w L with the largest safe β̄ (Theorem 4.5,
 /// eq. 4.19; Theorem 4.9, eq. 4.30 when estimated), coordinate h = argmax |∇_{w_j} L| with
 /// d at σ_h.
-pub(crate) fn w_step_surrogate(
+pub fn w_step_surrogate(
     k: &TaskConstants,
     sigmas: &[f64],
     gl: &Grad,
@@ -132,7 +127,7 @@ pub(crate) fn w_step_surrogate(
 
 /// The naive greedy-coordinate w-update along ∇_w J, eq. (4.12), with the largest safe
 /// β̄ = (1 + λ_w)β* (Theorem 4.3, eq. 4.17; Theorem 4.8, eq. 4.29 when estimated).
-pub(crate) fn w_step_naive(
+pub fn w_step_naive(
     k: &TaskConstants,
     sigmas: &[f64],
     gj: &Grad,
@@ -161,7 +156,7 @@ pub(crate) fn w_step_naive(
 /// ```text
 /// Δw_h = min(0, min_{β ∈ [lo, hi]} β ∇_{w_h} J) = min(0, lo·∇_{w_h} J, hi·∇_{w_h} J)
 /// ```
-pub(crate) fn lv_target(
+pub fn lv_target(
     k: &TaskConstants,
     sigmas: &[f64],
     gj: &Grad,
@@ -193,7 +188,7 @@ pub(crate) fn lv_target(
 /// j = argmin σ:  ∇_{w_j} L = σ_j ∂_σ L(σ_j)       (sepg_bounds::surrogate::grad_w, eq. B.1)
 /// otherwise:     ∇_{w_j} L = 2⟨∇_v J, ∂_{w_j}∇_v J⟩ / (4 m c(σ_min))   (c does not move)
 /// ```
-pub(crate) fn surrogate_grad_w(
+pub fn surrogate_grad_w(
     k: &TaskConstants,
     grad_v: &[f64],
     mixed_wv: &[f64],
@@ -231,11 +226,7 @@ pub(crate) fn surrogate_grad_w(
 /// The adaptive step of Pirotta et al. with fixed σ: α* of Corollary 3.11 (exact) or
 /// Theorem 3.12 (estimated), and its guaranteed improvement; `None` for a zero or sub-noise
 /// gradient.
-pub(crate) fn ada_step(
-    k: &TaskConstants,
-    sigma: f64,
-    g: &Grad,
-) -> Result<Option<(f64, f64)>, RunError> {
+pub fn ada_step(k: &TaskConstants, sigma: f64, g: &Grad) -> Result<Option<(f64, f64)>, RunError> {
     let step = if is_exact(g) {
         pirotta::optimal_step(k, sigma, &g.value)
     } else {
