@@ -41,6 +41,17 @@ impl CliError {
     }
 }
 
+impl From<sepg_runs::Error> for CliError {
+    /// Bad input exits with status 2, every other error of a run with status 1.
+    fn from(e: sepg_runs::Error) -> Self {
+        if e.is_invalid_input() {
+            CliError::usage(e.to_string())
+        } else {
+            CliError::failure(e.to_string())
+        }
+    }
+}
+
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // Keep the report on a single line whatever the underlying error printed.
@@ -80,7 +91,7 @@ enum Command {
     Sweep(commands::sweep::SweepArgs),
     /// Combine the shard folders of one sweep into a single sweep folder.
     Merge(commands::merge::MergeArgs),
-    /// Reproduce Table 5.1 or Figures 5.1–5.4 of the thesis (SPEC §6 protocol).
+    /// Reproduce Table 5.1 or Figures 5.1–5.4 of the thesis (the protocol of Sec 5.1).
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Plot performance, σ, v and budget of a run or sweep folder.
     Plot(commands::plot::PlotArgs),

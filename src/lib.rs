@@ -9,6 +9,8 @@
 //!   policy, the deterministic parallel rollout engine and the exact LQG oracles;
 //! - [`estimators`]: REINFORCE, G(PO)MDP, baselines, ∇_w L and confidence widths;
 //! - [`algo`]: SEPG with every safety requirement and the comparison algorithms;
+//! - [`runs`]: run folders (checkpoint, resume), sweeps, shards and merging, the audit, the
+//!   reproduction of the thesis experiments, tables and figures;
 //! - [`verification`]: the registry of numerical checks of every theorem of the thesis.
 //!
 //! The `sepg` binary built from this package is the command-line interface.
@@ -17,4 +19,5 @@ pub use sepg_algo as algo;
 pub use sepg_bounds as bounds;
 pub use sepg_estimators as estimators;
 pub use sepg_mdp as mdp;
+pub use sepg_runs as runs;
 pub use sepg_verification as verification;

@@ -6,50 +6,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-
-/// The error type of the command line (`src/cli.rs`), reduced to what the run folder code
-/// uses: a message and an exit status.
-mod cli {
-    use std::fmt;
-
-    #[derive(Debug)]
-    pub struct CliError {
-        pub code: u8,
-        pub message: String,
-    }
-
-    impl CliError {
-        pub fn usage(message: impl Into<String>) -> Self {
-            CliError {
-                code: 2,
-                message: message.into(),
-            }
-        }
-
-        pub fn failure(message: impl Into<String>) -> Self {
-            CliError {
-                code: 1,
-                message: message.into(),
-            }
-        }
-    }
-
-    impl fmt::Display for CliError {
-        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-            write!(f, "{} (exit status {})", self.message, self.code)
-        }
-    }
-}
-
-#[allow(dead_code, unused_imports)]
-#[path = "../../src/output.rs"]
-mod output;
-
-#[allow(dead_code, unused_imports)]
-#[path = "../../src/commands/runfmt.rs"]
-mod runfmt;
-
-use runfmt::{RunSpec, Values};
+use sepg_runs::spec::{RunSpec, Values};
 
 fn finite_values(v: &Option<Values>) -> bool {
     match v {

@@ -1,12 +1,15 @@
 //! `sepg run`: one run of SEPG or a comparison algorithm into a run folder (`config.toml`,
 //! `log.csv`, `summary.json`, `checkpoint.json`), resumable bit for bit with `--resume`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use sepg_runs::folder::{self, RUN_FILES, Summary};
+use sepg_runs::run::{self, RunOptions};
+use sepg_runs::spec::RunSpec;
 
 use crate::cli::CliError;
-use crate::commands::runfmt::{self, RUN_FILES, RunOptions, RunSpec, Summary};
+use crate::progress::{self, Bar, STOP};
 
 /// Arguments of `sepg run`.
 #[derive(Debug, Args)]
@@ -34,7 +37,7 @@ pub struct RunArgs {
 }
 
 /// The one-line report of a finished run.
-pub fn summary_line(dir: &std::path::Path, s: &Summary) -> String {
+pub fn summary_line(dir: &Path, s: &Summary) -> String {
     let mut line = format!(
         "{}: {} iterations in {:.2} s ({:.0} it/s, {:.3e} env steps/s)",
         dir.display(),
@@ -58,11 +61,13 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if args.checkpoint_every == 0 {
         return Err(CliError::usage("--checkpoint-every must be at least 1"));
     }
+    let bar = Bar::iterations(!args.quiet);
     let opts = RunOptions {
         checkpoint_every: args.checkpoint_every,
-        progress: !args.quiet,
+        stop: &STOP,
+        observer: &bar,
     };
-    runfmt::install_interrupt_handler();
+    progress::install_interrupt_handler();
     let (dir, summary) = if let Some(dir) = &args.resume {
         if args.config.is_some()
             || args.out.is_some()
@@ -73,7 +78,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
                 "--resume takes no other options than --quiet and --checkpoint-every",
             ));
         }
-        (dir.clone(), runfmt::resume(dir, opts)?)
+        (dir.clone(), run::resume(dir, opts)?)
     } else {
         let file = match &args.config {
             Some(path) => RunSpec::from_file(path)?,
@@ -89,8 +94,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             .out
             .clone()
             .ok_or_else(|| CliError::usage("--out DIR is required"))?;
-        runfmt::check_out_dir(&dir, args.force, &RUN_FILES)?;
-        (dir.clone(), runfmt::start(&dir, &resolved, opts)?)
+        folder::check_out_dir(&dir, args.force, &RUN_FILES)?;
+        (dir.clone(), run::start(&dir, &resolved, opts)?)
     };
     if !args.quiet {
         println!("{}", summary_line(&dir, &summary));

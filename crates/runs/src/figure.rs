@@ -9,8 +9,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use sepg_estimators::student_t_quantile;
 
-use crate::cli::CliError;
-use crate::output::write_atomic;
+use crate::error::{Error, Result};
+use crate::folder::write_atomic;
 
 /// DejaVu Sans restricted to Latin, Greek and mathematical symbols (see
 /// `figure/LICENSE-DejaVu.txt`).
@@ -112,14 +112,14 @@ pub fn mean_halfwidth(ys: &[f64]) -> (f64, Option<f64>) {
     (m, Some(t * (var / k as f64).sqrt()))
 }
 
-fn register_font() -> Result<(), CliError> {
+fn register_font() -> Result<()> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE
         .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
     if ok {
         Ok(())
     } else {
-        Err(CliError::failure("the embedded font cannot be loaded"))
+        Err(Error::failed("the embedded font cannot be loaded"))
     }
 }
 
@@ -188,90 +188,90 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     let cols = fig.columns.max(1);
     let rows = fig.panels.len().div_ceil(cols).max(1);
     for (cell, panel) in area.split_evenly((rows, cols)).iter().zip(&fig.panels) {
-        let (x0, x1, y0, y1) = range(panel);
-        let mut chart = ChartBuilder::on(cell)
-            .caption(&panel.title, (FAMILY, 16))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc(panel.x_label.as_str())
-            .y_desc(panel.y_label.as_str())
-            .label_style((FAMILY, 12))
-            .axis_desc_style((FAMILY, 13))
-            .x_labels(6)
-            .y_labels(6)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(e)?;
-        for (i, s) in panel.series.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
-            if let Some((lo, hi)) = &s.band {
-                let mut poly: Vec<(f64, f64)> =
-                    s.x.iter()
-                        .zip(hi)
-                        .filter(|(x, y)| x.is_finite() && y.is_finite())
-                        .map(|(&x, &y)| (x, y))
-                        .collect();
-                poly.extend(
-                    s.x.iter()
-                        .zip(lo)
-                        .rev()
-                        .filter(|(x, y)| x.is_finite() && y.is_finite())
-                        .map(|(&x, &y)| (x, y)),
-                );
-                chart
-                    .draw_series(std::iter::once(Polygon::new(
-                        poly,
-                        color.mix(0.18).filled(),
-                    )))
-                    .map_err(e)?;
-            }
-            let pts: Vec<(f64, f64)> =
-                s.x.iter()
-                    .zip(&s.mean)
-                    .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    .map(|(&x, &y)| (x, y))
-                    .collect();
-            chart
-                .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                .map_err(e)?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-        }
-        for (label, y) in &panel.hlines {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    vec![(x0, *y), (x1, *y)],
-                    6,
-                    4,
-                    BLACK.stroke_width(1),
-                ))
-                .map_err(e)?
-                .label(label.as_str())
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1))
-                });
-        }
-        if !panel.series.is_empty() || !panel.hlines.is_empty() {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .label_font((FAMILY, 11))
-                .draw()
-                .map_err(e)?;
-        }
+        draw_panel(cell, panel)?;
     }
     root.present().map_err(e)
+}
+
+/// The (x, y) points of a curve where both are finite.
+fn finite_points<'a>(
+    points: impl Iterator<Item = (&'a f64, &'a f64)>,
+) -> impl Iterator<Item = (f64, f64)> {
+    points
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(&x, &y)| (x, y))
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    cell: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let (x0, x1, y0, y1) = range(panel);
+    let mut chart = ChartBuilder::on(cell)
+        .caption(&panel.title, (FAMILY, 16))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 13))
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE)
+        .draw()
+        .map_err(e)?;
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        if let Some((lo, hi)) = &s.band {
+            let mut poly: Vec<(f64, f64)> = finite_points(s.x.iter().zip(hi)).collect();
+            poly.extend(finite_points(s.x.iter().zip(lo).rev()));
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    poly,
+                    color.mix(0.18).filled(),
+                )))
+                .map_err(e)?;
+        }
+        let pts: Vec<(f64, f64)> = finite_points(s.x.iter().zip(&s.mean)).collect();
+        chart
+            .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+            .map_err(e)?
+            .label(s.label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+    }
+    for (label, y) in &panel.hlines {
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(x0, *y), (x1, *y)],
+                6,
+                4,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(e)?
+            .label(label.as_str())
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1)));
+    }
+    if !panel.series.is_empty() || !panel.hlines.is_empty() {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .label_font((FAMILY, 11))
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
 }
 
 fn size(fig: &Figure) -> (u32, u32) {
@@ -284,10 +284,10 @@ fn size(fig: &Figure) -> (u32, u32) {
 /// temporary file in the same folder, then renamed).
 ///
 /// # Errors
-/// Usage error for another extension; failure when rendering or writing fails.
-pub fn save(fig: &Figure, path: &Path) -> Result<(), CliError> {
+/// [`Error::Invalid`] for another extension; [`Error::Failed`] when rendering or writing fails.
+pub fn save(fig: &Figure, path: &Path) -> Result<()> {
     register_font()?;
-    let fail = |e: String| CliError::failure(format!("cannot draw {}: {e}", path.display()));
+    let fail = |e: String| Error::failed(format!("cannot draw {}: {e}", path.display()));
     match path.extension().and_then(|e| e.to_str()) {
         Some("svg") => {
             let mut svg = String::new();
@@ -306,19 +306,17 @@ pub fn save(fig: &Figure, path: &Path) -> Result<(), CliError> {
                 .prefix(".sepg-figure-")
                 .suffix(".png")
                 .tempfile_in(&dir)
-                .map_err(|e| {
-                    CliError::failure(format!("cannot write in {}: {e}", dir.display()))
-                })?;
+                .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
             {
                 let root = BitMapBackend::new(tmp.path(), size(fig)).into_drawing_area();
                 draw(&root, fig).map_err(fail)?;
             }
             tmp.persist(path).map_err(|e| {
-                CliError::failure(format!("cannot write {}: {}", path.display(), e.error))
+                Error::failed(format!("cannot write {}: {}", path.display(), e.error))
             })?;
             Ok(())
         }
-        _ => Err(CliError::usage(format!(
+        _ => Err(Error::invalid(format!(
             "{}: figures are written as .png or .svg",
             path.display()
         ))),
@@ -329,7 +327,7 @@ pub fn save(fig: &Figure, path: &Path) -> Result<(), CliError> {
 ///
 /// # Errors
 /// As [`save`].
-pub fn save_both(fig: &Figure, dir: &Path, stem: &str) -> Result<[PathBuf; 2], CliError> {
+pub fn save_both(fig: &Figure, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
     let png = dir.join(format!("{stem}.png"));
     let svg = dir.join(format!("{stem}.svg"));
     save(fig, &png)?;

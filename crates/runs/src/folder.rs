@@ -1,0 +1,438 @@
+//! The run folder shared by runs, sweeps, audits and reproductions: its files, the columns
+//! of `log.csv`, the checkpoint and the summary, and reading them back.
+//!
+//! # Folder layout and completeness rule
+//! ```text
+//! config.toml      resolved configuration (every option, the seed and the sepg version)
+//! checkpoint.json  state after the last checkpointed iteration and the valid log length
+//! log.partial.csv  rows of an unfinished run (valid up to the checkpoint's log_bytes)
+//! log.csv          all rows; exists only once every iteration has been written
+//! summary.json     final parameters and timings; written last: the run is complete iff it exists
+//! ```
+//! How a run writes these files, and resumes from them, is the subject of [`crate::run`].
+
+use std::fs;
+use std::io::Write;
+use std::path::Path;
+
+use sepg_algo::core::record::Record;
+use sepg_algo::core::state::State;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::spec::{Resolved, RunSpec, VERSION};
+
+/// Resolved configuration of a run.
+pub const CONFIG_FILE: &str = "config.toml";
+/// Checkpoint: state after the last checkpointed iteration.
+pub const CHECKPOINT_FILE: &str = "checkpoint.json";
+/// Log of an unfinished run.
+pub const PARTIAL_LOG_FILE: &str = "log.partial.csv";
+/// Log of a finished run.
+pub const LOG_FILE: &str = "log.csv";
+/// Summary of a finished run (its presence marks the run as complete).
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// Files a run writes; `--force` removes exactly these from an existing folder.
+pub const RUN_FILES: [&str; 5] = [
+    CONFIG_FILE,
+    CHECKPOINT_FILE,
+    PARTIAL_LOG_FILE,
+    LOG_FILE,
+    SUMMARY_FILE,
+];
+
+/// Writes `contents` to `path` atomically: the bytes go to a temporary file in the same
+/// directory, which is then renamed over `path`, so a reader never sees a partial file.
+/// On Unix the file is created with mode 0644 (less the umask), like an ordinary output file,
+/// so run folders stay readable by collaborators on shared machines.
+///
+/// # Errors
+/// [`Error::Failed`] when the folder cannot be written.
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder
+        .tempfile_in(dir)
+        .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
+    tmp.write_all(contents)
+        .and_then(|()| tmp.as_file().sync_all())
+        .map_err(|e| Error::failed(format!("cannot write {}: {e}", path.display())))?;
+    tmp.persist(path)
+        .map_err(|e| Error::failed(format!("cannot write {}: {}", path.display(), e.error)))?;
+    Ok(())
+}
+
+/// Serialises `value` as pretty JSON followed by a newline.
+///
+/// # Errors
+/// [`Error::Failed`] if serialisation fails.
+pub fn to_json_line<T: serde::Serialize>(value: &T) -> Result<String> {
+    let mut s = serde_json::to_string_pretty(value)
+        .map_err(|e| Error::failed(format!("cannot serialise output: {e}")))?;
+    s.push('\n');
+    Ok(s)
+}
+
+fn indexed(name: &str, dim: usize) -> Vec<String> {
+    if dim == 1 {
+        vec![name.to_owned()]
+    } else {
+        (0..dim).map(|i| format!("{name}_{i}")).collect()
+    }
+}
+
+/// The header of `log.csv` for `dim_v` mean parameters and `dim_w` standard deviations.
+///
+/// Columns: `iteration`, `v` (or `v_0, v_1, …`), `w`, `sigma`, `j_explore`, `j_after_v`,
+/// `j_target`, `w_target`, `budget`, `required`, `required_w`, `alpha`, `beta`, `lambda_v`,
+/// `lambda_w`, `guaranteed_v`, `guaranteed_w`, `infeasible`, `infeasible_v`, `infeasible_w`,
+/// `below_noise_v`, `below_noise_w`, `trajectories`, `steps`.
+pub fn log_header(dim_v: usize, dim_w: usize) -> String {
+    let mut cols = vec!["iteration".to_owned()];
+    cols.extend(indexed("v", dim_v));
+    cols.extend(indexed("w", dim_w));
+    cols.extend(indexed("sigma", dim_w));
+    cols.extend(["j_explore", "j_after_v", "j_target"].map(String::from));
+    cols.extend(indexed("w_target", dim_w));
+    cols.extend(
+        [
+            "budget",
+            "required",
+            "required_w",
+            "alpha",
+            "beta",
+            "lambda_v",
+            "lambda_w",
+            "guaranteed_v",
+            "guaranteed_w",
+            "infeasible",
+            "infeasible_v",
+            "infeasible_w",
+            "below_noise_v",
+            "below_noise_w",
+            "trajectories",
+            "steps",
+        ]
+        .map(String::from),
+    );
+    let mut s = cols.join(",");
+    s.push('\n');
+    s
+}
+
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map(num).unwrap_or_default()
+}
+
+/// One row of `log.csv` for `record` (shortest round-trip decimal; empty for "not
+/// applicable"; `-inf` for the deterministic target's `w_target`; booleans as 0/1).
+pub fn log_row(r: &Record) -> String {
+    let mut cells = vec![r.iteration.to_string()];
+    cells.extend(r.v.iter().copied().map(num));
+    cells.extend(r.w.iter().copied().map(num));
+    cells.extend(r.sigma.iter().copied().map(num));
+    cells.extend([num(r.j_exploratory), opt(r.j_after_v), num(r.j_target)]);
+    match &r.w_target {
+        Some(w) => cells.extend(w.iter().copied().map(num)),
+        None => cells.extend(r.w.iter().map(|_| num(f64::NEG_INFINITY))),
+    }
+    let b = |x: bool| if x { "1".to_owned() } else { "0".to_owned() };
+    cells.extend([
+        num(r.budget),
+        opt(r.required_v),
+        opt(r.required_w),
+        num(r.alpha),
+        num(r.beta),
+        opt(r.lambda_v),
+        opt(r.lambda_w),
+        opt(r.guaranteed_v),
+        opt(r.guaranteed_w),
+        b(r.infeasible_v || r.infeasible_w),
+        b(r.infeasible_v),
+        b(r.infeasible_w),
+        b(r.below_noise_v),
+        b(r.below_noise_w),
+        r.trajectories.to_string(),
+        r.steps.to_string(),
+    ]);
+    let mut s = cells.join(",");
+    s.push('\n');
+    s
+}
+
+/// Counters over the whole run, carried in the checkpoint so that a resumed run reports the
+/// same totals.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Tally {
+    /// Iterations whose v- or w-requirement was infeasible (λ = 0 fallback).
+    pub infeasible: u64,
+    /// Iterations whose v-gradient was below its noise level.
+    pub below_noise_v: u64,
+    /// Iterations whose w-direction was below its noise level.
+    pub below_noise_w: u64,
+    /// J of the exploratory policy at the last iteration.
+    pub last_j_explore: Option<f64>,
+    /// J of the target policy at the last iteration.
+    pub last_j_target: Option<f64>,
+}
+
+impl Tally {
+    /// Counts the iteration of `r`.
+    pub(crate) fn add(&mut self, r: &Record) {
+        self.infeasible += u64::from(r.infeasible_v || r.infeasible_w);
+        self.below_noise_v += u64::from(r.below_noise_v);
+        self.below_noise_w += u64::from(r.below_noise_w);
+        self.last_j_explore = Some(r.j_exploratory);
+        self.last_j_target = Some(r.j_target);
+    }
+}
+
+/// The checkpoint file: the state after `state.iteration` iterations and the length of the
+/// log that holds exactly the rows of those iterations.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// Bytes of the log (header included) written up to this checkpoint.
+    pub log_bytes: u64,
+    /// Wall time spent in iterations so far, in seconds.
+    pub elapsed_s: f64,
+    /// Counters so far.
+    pub tally: Tally,
+    /// The algorithm's state (resumable bit for bit).
+    pub state: State,
+}
+
+/// Final parameters of a run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FinalParams {
+    /// Mean parameters v.
+    pub v: Vec<f64>,
+    /// Log standard deviations w.
+    pub w: Vec<f64>,
+    /// Standard deviations σ = e^w.
+    pub sigma: Vec<f64>,
+    /// Budget B.
+    pub budget: f64,
+}
+
+/// `summary.json`: written last, its presence marks a complete run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Summary {
+    /// Always `"complete"`.
+    pub status: String,
+    /// Label of the run.
+    pub name: String,
+    /// Version of sepg that ran it.
+    pub sepg_version: String,
+    /// Iterations run.
+    pub iterations: u64,
+    /// Parameters after the last iteration.
+    #[serde(rename = "final")]
+    pub final_params: FinalParams,
+    /// v* (LQG only).
+    pub v_star: Option<Vec<f64>>,
+    /// max_i |v_i − v*_i| after the last iteration (LQG only).
+    pub abs_v_error: Option<f64>,
+    /// J of the exploratory policy at the last iteration.
+    pub last_j_explore: Option<f64>,
+    /// J of the target policy at the last iteration.
+    pub last_j_target: Option<f64>,
+    /// Iterations with an infeasible requirement.
+    pub infeasible_iterations: u64,
+    /// Iterations without a v-update (gradient below noise).
+    pub below_noise_v_iterations: u64,
+    /// Iterations without a w-update (direction below noise).
+    pub below_noise_w_iterations: u64,
+    /// Trajectories used.
+    pub trajectories: u64,
+    /// Environment steps used.
+    pub steps: u64,
+    /// Wall time spent iterating, in seconds (summed over resumed segments).
+    pub wall_time_s: f64,
+    /// Iterations per second of wall time.
+    pub iterations_per_s: f64,
+    /// Environment steps per second of wall time.
+    pub env_steps_per_s: f64,
+}
+
+/// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.
+pub(crate) fn io_fail(what: &str, path: &Path, e: std::io::Error) -> Error {
+    Error::failed(format!("cannot {what} {}: {e}", path.display()))
+}
+
+/// Checks that `dir` is absent or empty; with `force`, removes the run files a previous run
+/// left there (and only those).
+///
+/// # Errors
+/// [`Error::Invalid`] for a non-empty folder without `force`, or a path that is not a folder.
+pub fn check_out_dir(dir: &Path, force: bool, files: &[&str]) -> Result<()> {
+    if !dir.exists() {
+        return Ok(());
+    }
+    if !dir.is_dir() {
+        return Err(Error::invalid(format!(
+            "{} exists and is not a folder",
+            dir.display()
+        )));
+    }
+    let mut entries = fs::read_dir(dir)
+        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", dir.display())))?;
+    if entries.next().is_some() && !force {
+        return Err(Error::invalid(format!(
+            "output folder {} is not empty (use --force to overwrite its run files)",
+            dir.display()
+        )));
+    }
+    for f in files {
+        let p = dir.join(f);
+        if p.is_dir() {
+            fs::remove_dir_all(&p).map_err(|e| io_fail("remove", &p, e))?;
+        } else if p.exists() {
+            fs::remove_file(&p).map_err(|e| io_fail("remove", &p, e))?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether `dir` holds a complete run.
+pub fn is_complete(dir: &Path) -> bool {
+    dir.join(SUMMARY_FILE).is_file()
+}
+
+/// Reads and resolves the configuration of the run folder `dir`.
+///
+/// # Errors
+/// [`Error::Invalid`] for a missing or invalid configuration or one written by another sepg version.
+pub fn load_resolved(dir: &Path) -> Result<Resolved> {
+    let path = dir.join(CONFIG_FILE);
+    if !path.is_file() {
+        return Err(Error::invalid(format!(
+            "{} is not a run folder (no {CONFIG_FILE})",
+            dir.display()
+        )));
+    }
+    let spec = RunSpec::from_file(&path)?;
+    if let Some(v) = &spec.sepg_version
+        && v != VERSION
+    {
+        return Err(Error::invalid(format!(
+            "{} was written by sepg {v}; this is sepg {VERSION}, which may not reproduce it bit for bit",
+            path.display()
+        )));
+    }
+    spec.resolve()
+}
+
+/// Reads `summary.json` of a complete run.
+///
+/// # Errors
+/// [`Error::Failed`] when the file cannot be read or parsed.
+pub fn read_summary(dir: &Path) -> Result<Summary> {
+    let p = dir.join(SUMMARY_FILE);
+    let text = fs::read_to_string(&p).map_err(|e| io_fail("read", &p, e))?;
+    serde_json::from_str(&text)
+        .map_err(|e| Error::failed(format!("{} is invalid: {e}", p.display())))
+}
+
+/// A log read back from disk: column names and one row of numbers per logged iteration
+/// (empty cells read as NaN).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Log {
+    /// Column names.
+    pub columns: Vec<String>,
+    /// Rows of values.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Log {
+    /// Reads `log.csv` of a complete run, or the checkpointed prefix of `log.partial.csv`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] when no log can be read.
+    pub fn read_run(dir: &Path) -> Result<Log> {
+        let done = dir.join(LOG_FILE);
+        let bytes = if done.is_file() {
+            fs::read(&done)
+                .map_err(|e| Error::invalid(format!("cannot read {}: {e}", done.display())))?
+        } else {
+            let partial = dir.join(PARTIAL_LOG_FILE);
+            let mut b = fs::read(&partial)
+                .map_err(|e| Error::invalid(format!("no log in {}: {e}", dir.display())))?;
+            let ck: Option<Checkpoint> = fs::read_to_string(dir.join(CHECKPOINT_FILE))
+                .ok()
+                .and_then(|t| serde_json::from_str(&t).ok());
+            if let Some(ck) = ck {
+                b.truncate(
+                    usize::try_from(ck.log_bytes)
+                        .unwrap_or(usize::MAX)
+                        .min(b.len()),
+                );
+            }
+            b
+        };
+        let text = String::from_utf8_lossy(&bytes);
+        let mut lines = text.lines();
+        let columns: Vec<String> = lines
+            .next()
+            .ok_or_else(|| Error::invalid(format!("empty log in {}", dir.display())))?
+            .split(',')
+            .map(String::from)
+            .collect();
+        let rows = lines
+            .filter(|l| l.split(',').count() == columns.len())
+            .map(|l| {
+                l.split(',')
+                    .map(|c| c.parse::<f64>().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        Ok(Log { columns, rows })
+    }
+
+    /// The values of column `name` (or its first component `name_0`), if present.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let idx = self
+            .columns
+            .iter()
+            .position(|c| c == name)
+            .or_else(|| self.columns.iter().position(|c| *c == format!("{name}_0")))?;
+        Some(self.rows.iter().map(|r| r[idx]).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sepg_algo::core::executor::Solver;
+    use sepg_algo::solver::PolicySolver;
+
+    use super::*;
+
+    #[test]
+    fn header_and_rows_have_the_same_width() {
+        let resolved = RunSpec {
+            iterations: Some(2),
+            batch: Some(12),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid");
+        let mut solver = PolicySolver::new(&resolved.checked).expect("solver");
+        let mut state = resolved.checked.initial_state();
+        let r = solver.next_iter(&mut state).expect("iteration");
+        let header = log_header(1, 1);
+        assert_eq!(header.split(',').count(), log_row(&r).split(',').count());
+        assert!(header.starts_with("iteration,v,w,sigma,j_explore,"));
+    }
+}

@@ -1,0 +1,32 @@
+//! # sepg-runs — run folders, sweeps, audits and the reproduction of the thesis experiments
+//!
+//! The layers call downward only:
+//!
+//! ```text
+//! report, figure        Table 5.1 and Figures 5.1–5.4, plots of run and sweep folders
+//!   ↓
+//! reproduce             the experiments of thesis Chapter 5 as sweeps
+//!   ↓
+//! sweep, merge          products of runs, shards, merging shard folders
+//!   ↓
+//! run                   one run: execution, checkpoints, resume, stop flag, observer
+//!   ↓
+//! spec, folder          options and their resolution; the files of a run folder
+//! ```
+//!
+//! [`audit`] sits beside them: it reads a run folder ([`folder`], [`spec`]) and re-checks its
+//! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
+//! [`Error`]; nothing here prints.
+
+pub mod audit;
+pub mod error;
+pub mod figure;
+pub mod folder;
+pub mod merge;
+pub mod report;
+pub mod reproduce;
+pub mod run;
+pub mod spec;
+pub mod sweep;
+
+pub use error::{Error, Result};

@@ -1,0 +1,531 @@
+//! Reports made from finished runs: Table 5.1 (markdown and CSV, side by side with the
+//! published values) and Figures 5.1–5.4 of a reproduction (PNG and SVG, 95% bands across
+//! seeds), and the plots of any run or sweep folder.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::figure::{self, Figure, Panel, Series, mean_band, mean_halfwidth};
+use crate::folder::{CONFIG_FILE, Log, SUMMARY_FILE, Summary, is_complete};
+use crate::reproduce::{Experiment, ReproduceOptions, TABLE_VARIANTS};
+use crate::spec::{EnvName, RunSpec};
+use crate::sweep::{SWEEP_FILE, Seeds, SweepFile};
+
+/// Table 5.1 of the thesis (Sec 5.1.2, "Upper bound confidence intervals at
+/// 95% of |v − v*| after 10,000 iterations"), copied as published: for σ⁰ = 0.1, 0.2, 0.5,
+/// 1.0, the columns in [`TABLE_VARIANTS`] order (Adam 1e-4, 1e-5, 1e-6; constant step 1e-4,
+/// 1e-5, 1e-6; MI; LB-I; LB-II; LV; ZV). Values to compare against, not expectations.
+pub const THESIS_TABLE_5_1: [(f64, [f64; 11]); 4] = [
+    (
+        0.1,
+        [
+            0.126, 0.432, 0.506, 0.132, 0.026, 0.228, 0.515, 0.510, 0.368, 0.429, 0.435,
+        ],
+    ),
+    (
+        0.2,
+        [
+            0.08, 0.429, 0.506, 0.124, 0.018, 0.201, 0.515, 0.494, 0.039, 0.028, 0.056,
+        ],
+    ),
+    (
+        0.5,
+        [
+            0.061, 0.428, 0.506, 0.122, 0.012, 0.125, 0.511, 0.29, 0.009, 0.01, 0.006,
+        ],
+    ),
+    (
+        1.0,
+        [
+            0.046, 0.422, 0.505, 0.122, 0.011, 0.069, 0.497, 0.01, 0.021, 0.021, 0.028,
+        ],
+    ),
+];
+
+/// A finished run of the sweep: its entry, summary and log.
+struct Loaded {
+    preset: EnvName,
+    variant: String,
+    sigma0: f64,
+    summary: Summary,
+    log: Log,
+}
+
+fn load(dir: &Path, file: &SweepFile) -> Result<Vec<Loaded>> {
+    file.runs
+        .iter()
+        .map(|r| {
+            let run_dir = dir.join(&r.dir);
+            let text = std::fs::read_to_string(run_dir.join(SUMMARY_FILE))
+                .map_err(|e| Error::failed(format!("{}: {e}", run_dir.display())))?;
+            let summary: Summary = serde_json::from_str(&text)
+                .map_err(|e| Error::failed(format!("{}: {e}", run_dir.display())))?;
+            Ok(Loaded {
+                preset: r.preset,
+                variant: r.variant.clone(),
+                sigma0: r.sigma0,
+                summary,
+                log: Log::read_run(&run_dir)?,
+            })
+        })
+        .collect()
+}
+
+fn seed_count(seeds: &Seeds) -> u64 {
+    match seeds {
+        Seeds::Count(n) => *n,
+        Seeds::List(v) => v.len() as u64,
+    }
+}
+
+/// A CSV cell: shortest round-trip decimal, empty when undefined.
+fn csv_num(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:?}")
+    } else {
+        String::new()
+    }
+}
+
+fn fmt3(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.3}")
+    } else {
+        "—".into()
+    }
+}
+
+/// Table 5.1 as markdown and CSV.
+fn table(file: &SweepFile, runs: &[Loaded], delta: f64) -> (String, String) {
+    let seeds = seed_count(&file.spec.seeds);
+    let iterations = runs.first().map_or(0, |r| r.summary.iterations);
+    let mut md = String::new();
+    let mut csv = String::from("preset,sigma0,variant,seeds,iterations,mean,sd,ucb95,thesis\n");
+    let _ = writeln!(
+        md,
+        "# Table 5.1: 95% upper confidence bound of |v − v*| after {iterations} iterations\n\n\
+         {seeds} seeds, N = 100, H = 20, γ = 0.99, v⁰ = −0.1, δ = {}. Each cell: ours (thesis). \
+         Bound: mean + t(0.975, K − 1)·s/√K across the K seeds.\n",
+        delta
+    );
+    for &preset in &file.spec.presets {
+        let _ = writeln!(md, "## Preset `{}`\n", preset.name());
+        let _ = writeln!(md, "| σ⁰ | {} |", TABLE_VARIANTS.join(" | "));
+        let _ = writeln!(md, "|---|{}", "---|".repeat(TABLE_VARIANTS.len()));
+        for (sigma0, thesis) in THESIS_TABLE_5_1 {
+            let mut cells = Vec::new();
+            for (col, name) in TABLE_VARIANTS.iter().enumerate() {
+                let errors: Vec<f64> = runs
+                    .iter()
+                    .filter(|r| r.preset == preset && r.variant == *name && r.sigma0 == sigma0)
+                    .filter_map(|r| r.summary.abs_v_error)
+                    .collect();
+                let (mean, half) = mean_halfwidth(&errors);
+                let ucb = mean + half.unwrap_or(0.0);
+                let k = errors.len() as f64;
+                let sd = if k >= 2.0 {
+                    (errors.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>() / (k - 1.0)).sqrt()
+                } else {
+                    f64::NAN
+                };
+                cells.push(format!("{} ({})", fmt3(ucb), thesis[col]));
+                let _ = writeln!(
+                    csv,
+                    "{},{sigma0:?},{name},{},{iterations},{},{},{},{}",
+                    preset.name(),
+                    errors.len(),
+                    csv_num(mean),
+                    csv_num(sd),
+                    csv_num(ucb),
+                    thesis[col]
+                );
+            }
+            let _ = writeln!(md, "| {sigma0:?} | {} |", cells.join(" | "));
+        }
+        md.push('\n');
+    }
+    (md, csv)
+}
+
+/// Curves of `column` (x = iteration or trajectories) for every run of (preset, variant)
+/// at σ⁰, as mean and band across seeds.
+fn series(
+    runs: &[Loaded],
+    preset: EnvName,
+    variant: &str,
+    sigma0: f64,
+    x_col: &str,
+    y: &dyn Fn(&Log) -> Option<Vec<f64>>,
+) -> Option<Series> {
+    let group: Vec<&Loaded> = runs
+        .iter()
+        .filter(|r| r.preset == preset && r.variant == variant && r.sigma0 == sigma0)
+        .collect();
+    let curves: Vec<Vec<f64>> = group.iter().filter_map(|r| y(&r.log)).collect();
+    let x = group.first()?.log.column(x_col)?;
+    let (mean, band) = mean_band(&curves);
+    let x = x[..mean.len().min(x.len())].to_vec();
+    Some(Series {
+        label: variant.to_owned(),
+        x,
+        mean,
+        band,
+    })
+}
+
+fn col(name: &'static str) -> impl Fn(&Log) -> Option<Vec<f64>> {
+    move |log: &Log| log.column(name)
+}
+
+/// Running mean over the logged iterations of (J_E + J_T)/2: the type-II guarantee of
+/// Sec 5.1.2, (1/K) Σ_k (J(θᵏ) + J(θ_Tᵏ))/2 ≥ J_B.
+fn guarantee(log: &Log) -> Option<Vec<f64>> {
+    let je = log.column("j_explore")?;
+    let jt = log.column("j_target")?;
+    let mut sum = 0.0;
+    Some(
+        je.iter()
+            .zip(&jt)
+            .enumerate()
+            .map(|(k, (a, b))| {
+                sum += 0.5 * (a + b);
+                sum / (k + 1) as f64
+            })
+            .collect(),
+    )
+}
+
+/// What the panels of one preset's figure are drawn from.
+struct PanelMaker<'a> {
+    runs: &'a [Loaded],
+    names: &'a [String],
+    preset: EnvName,
+    sigma0: f64,
+    x_col: &'static str,
+}
+
+impl PanelMaker<'_> {
+    /// A panel with one curve per variant.
+    fn panel(&self, title: &str, y_label: &str, y: &dyn Fn(&Log) -> Option<Vec<f64>>) -> Panel {
+        Panel {
+            title: title.to_owned(),
+            x_label: self.x_col.to_owned(),
+            y_label: y_label.to_owned(),
+            series: self
+                .names
+                .iter()
+                .filter_map(|n| series(self.runs, self.preset, n, self.sigma0, self.x_col, y))
+                .collect(),
+            hlines: Vec::new(),
+        }
+    }
+
+    /// The panel of v, with v* as a reference line when known.
+    fn v_panel(&self, title: &str) -> Panel {
+        let mut p = self.panel(title, "v", &col("v"));
+        let v_star = self
+            .runs
+            .iter()
+            .find(|r| r.preset == self.preset)
+            .and_then(|r| r.summary.v_star.as_ref())
+            .map(|v| v[0]);
+        if let Some(v) = v_star {
+            p.hlines.push(("v*".into(), v));
+        }
+        p
+    }
+
+    /// The guarantee panel of Fig 5.2, with J_B = J(θ⁰) averaged over the seeds.
+    fn guarantee_panel(&self) -> Panel {
+        let mut g = self.panel("(d) guarantee mean of (J_E + J_T)/2", "J", &guarantee);
+        let first: Vec<f64> = self
+            .runs
+            .iter()
+            .filter(|r| r.preset == self.preset)
+            .filter_map(|r| r.log.column("j_explore").and_then(|c| c.first().copied()))
+            .collect();
+        g.hlines
+            .push(("J_B = J(θ⁰)".into(), mean_halfwidth(&first).0));
+        g
+    }
+
+    /// The panels of experiment `what`, in the thesis's order.
+    fn panels(&self, what: Experiment) -> Vec<Panel> {
+        match what {
+            Experiment::Fig51 => vec![
+                self.panel("(a) performance J(θᵗ)", "J", &col("j_explore")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+                self.v_panel("(c) mean parameter vᵗ"),
+            ],
+            Experiment::Fig52 => vec![
+                self.panel("(a) exploratory J(θ_E)", "J", &col("j_explore")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+                self.v_panel("(c) mean parameter vᵗ"),
+                self.guarantee_panel(),
+                self.panel("(e) target J(θ_T)", "J", &col("j_target")),
+                self.panel("(f) budget Bᵗ", "B", &col("budget")),
+            ],
+            Experiment::Fig53 => vec![
+                self.panel("(a) exploratory J(θ_E)", "J", &col("j_explore")),
+                self.panel("(b) target J(θ_T)", "J", &col("j_target")),
+                self.v_panel("(c) mean parameter vᵗ"),
+                self.panel("(d) standard deviation σᵗ", "σ", &col("sigma")),
+            ],
+            Experiment::Fig54 | Experiment::Table51 => vec![
+                self.panel("(a) performance J(θᵗ)", "J", &col("j_explore")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+            ],
+        }
+    }
+}
+
+/// The figures of experiment `what` (one per preset) with their file stems.
+fn figures(
+    what: Experiment,
+    file: &SweepFile,
+    runs: &[Loaded],
+    delta: f64,
+) -> Vec<(String, Figure)> {
+    let sigma0 = file.spec.sigma0[0];
+    let names: Vec<String> = file
+        .spec
+        .variant
+        .iter()
+        .filter_map(|v| v.name.clone())
+        .collect();
+    let x_col = if what == Experiment::Fig53 {
+        "trajectories"
+    } else {
+        "iteration"
+    };
+    let mut out = Vec::new();
+    for &preset in &file.spec.presets {
+        let maker = PanelMaker {
+            runs,
+            names: &names,
+            preset,
+            sigma0,
+            x_col,
+        };
+        let panels = maker.panels(what);
+        let seeds = seed_count(&file.spec.seeds);
+        let title = format!(
+            "{} — {}, σ⁰ = {sigma0}, {seeds} seeds, δ = {delta} (mean, 95% band)",
+            what.name(),
+            preset.name(),
+        );
+        let columns = if panels.len() > 4 {
+            3
+        } else {
+            panels.len().min(2)
+        };
+        let stem = if what == Experiment::Fig54 {
+            what.name().to_owned()
+        } else {
+            format!("{}-{}", what.name(), preset.name())
+        };
+        out.push((
+            stem,
+            Figure {
+                title,
+                panels,
+                columns,
+            },
+        ));
+    }
+    out
+}
+
+/// What a reproduction wrote next to its runs.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Outputs {
+    /// Table 5.1, written as `table-5.1.md` and `table-5.1.csv`.
+    Table {
+        /// The markdown table.
+        markdown: String,
+    },
+    /// The figures, each as PNG and SVG.
+    Figures {
+        /// The files written, in order.
+        paths: Vec<PathBuf>,
+    },
+}
+
+/// Writes the table or figures of the finished reproduction in `dir` (whose `sweep.json` is
+/// `file`, run with `opts`).
+///
+/// # Errors
+/// [`Error::Failed`] when a run cannot be read or a file cannot be written or drawn.
+pub fn write_outputs(opts: &ReproduceOptions, dir: &Path, file: &SweepFile) -> Result<Outputs> {
+    let runs = load(dir, file)?;
+    if opts.what == Experiment::Table51 {
+        let (markdown, csv) = table(file, &runs, opts.delta);
+        crate::folder::write_atomic(&dir.join("table-5.1.md"), markdown.as_bytes())?;
+        crate::folder::write_atomic(&dir.join("table-5.1.csv"), csv.as_bytes())?;
+        return Ok(Outputs::Table { markdown });
+    }
+    let mut paths = Vec::new();
+    for (stem, fig) in figures(opts.what, file, &runs, opts.delta) {
+        paths.extend(figure::save_both(&fig, dir, &stem)?);
+    }
+    Ok(Outputs::Figures { paths })
+}
+
+/// The (column, panel title, axis label) of the four panels.
+const PANELS: [(&str, &str, &str); 4] = [
+    (
+        "j_explore",
+        "performance J(θᵗ) of the exploratory policy",
+        "J",
+    ),
+    ("sigma", "standard deviation σᵗ", "σ"),
+    ("v", "mean parameter vᵗ (first component)", "v"),
+    ("budget", "budget Bᵗ", "B"),
+];
+
+fn one_run(dir: &Path) -> Result<Figure> {
+    let log = Log::read_run(dir)?;
+    let x = log
+        .column("iteration")
+        .ok_or_else(|| Error::invalid(format!("{}: log has no iteration column", dir.display())))?;
+    let name = RunSpec::from_file(&dir.join(CONFIG_FILE))?
+        .name
+        .unwrap_or_default();
+    let panels = PANELS
+        .iter()
+        .map(|&(col, title, y)| {
+            let mut series: Vec<Series> = log
+                .column(col)
+                .map(|mean| Series {
+                    label: name.clone(),
+                    x: x.clone(),
+                    mean,
+                    band: None,
+                })
+                .into_iter()
+                .collect();
+            if col == "j_explore"
+                && let Some(mean) = log.column("j_target")
+            {
+                series.push(Series {
+                    label: format!("{name} target"),
+                    x: x.clone(),
+                    mean,
+                    band: None,
+                });
+            }
+            Panel {
+                title: title.into(),
+                x_label: "iteration".into(),
+                y_label: y.into(),
+                series,
+                hlines: Vec::new(),
+            }
+        })
+        .collect();
+    let complete = if is_complete(dir) {
+        ""
+    } else {
+        " (incomplete run)"
+    };
+    Ok(Figure {
+        title: format!("{}{complete}", dir.display()),
+        panels,
+        columns: 2,
+    })
+}
+
+fn sweep_figure(dir: &Path, file: &SweepFile) -> Result<Figure> {
+    let mut groups: Vec<(String, Vec<Log>)> = Vec::new();
+    for r in file.shard_runs() {
+        let run_dir = dir.join(&r.dir);
+        if !run_dir.join(CONFIG_FILE).is_file() {
+            continue;
+        }
+        let label = format!("{}/{}/σ⁰={}", r.preset.name(), r.variant, r.sigma0);
+        let log = Log::read_run(&run_dir)?;
+        match groups.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, logs)) => logs.push(log),
+            None => groups.push((label, vec![log])),
+        }
+    }
+    if groups.is_empty() {
+        return Err(Error::invalid(format!(
+            "{} has no started run yet",
+            dir.display()
+        )));
+    }
+    let panels = PANELS
+        .iter()
+        .map(|&(col, title, y)| {
+            let series = groups
+                .iter()
+                .filter_map(|(label, logs)| {
+                    let curves: Vec<Vec<f64>> = logs.iter().filter_map(|l| l.column(col)).collect();
+                    let x = logs
+                        .iter()
+                        .filter_map(|l| l.column("iteration"))
+                        .min_by_key(Vec::len)?;
+                    let (mean, band) = mean_band(&curves);
+                    Some(Series {
+                        label: label.clone(),
+                        x: x[..mean.len()].to_vec(),
+                        mean,
+                        band,
+                    })
+                })
+                .collect();
+            Panel {
+                title: title.into(),
+                x_label: "iteration".into(),
+                y_label: y.into(),
+                series,
+                hlines: Vec::new(),
+            }
+        })
+        .collect();
+    Ok(Figure {
+        title: format!("{} (mean and 95% band across seeds)", dir.display()),
+        panels,
+        columns: 2,
+    })
+}
+
+/// Plots performance, σ, v and budget of the run or sweep folder `dir` into `out` (.png or
+/// .svg), or into `dir/plot.png` and `dir/plot.svg`; returns the files written.
+///
+/// # Errors
+/// [`Error::Invalid`] for a folder that is neither a run nor a sweep, or an output file that
+/// is not .png or .svg; [`Error::Failed`] when drawing or writing fails.
+pub fn plot(dir: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>> {
+    if let Some(out) = out
+        && !matches!(
+            out.extension().and_then(|e| e.to_str()),
+            Some("png" | "svg")
+        )
+    {
+        return Err(Error::invalid(format!(
+            "{}: figures are written as .png or .svg",
+            out.display()
+        )));
+    }
+    let fig = if dir.join(SWEEP_FILE).is_file() {
+        sweep_figure(dir, &SweepFile::read(dir)?)?
+    } else if dir.join(CONFIG_FILE).is_file() {
+        one_run(dir)?
+    } else {
+        return Err(Error::invalid(format!(
+            "{} is neither a run folder nor a sweep folder",
+            dir.display()
+        )));
+    };
+    match out {
+        Some(out) => {
+            figure::save(&fig, out)?;
+            Ok(vec![out.to_path_buf()])
+        }
+        None => Ok(figure::save_both(&fig, dir, "plot")?.to_vec()),
+    }
+}

@@ -1,0 +1,270 @@
+//! One run: executes an algorithm of `sepg-algo` into a run folder, checkpointing as it goes,
+//! and resumes it bit for bit.
+//!
+//! Rows are appended in chunks of `checkpoint_every` iterations; after each chunk the log is
+//! flushed to disk and the checkpoint is replaced atomically. A run killed at any point
+//! therefore leaves a checkpoint whose state matches the first `log_bytes` bytes of
+//! `log.partial.csv`, and resuming truncates the log there and continues. Because every batch
+//! of trajectories is seeded by (seed, iteration, block), the resumed run produces the same
+//! rows, bit for bit, as an uninterrupted one.
+//!
+//! A run stops early, after checkpointing, when its stop flag is raised (the command line
+//! raises it on Ctrl-C); it reports its progress to an [`Observer`].
+
+use std::fs::{self, File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use sepg_algo::core::executor::Solver;
+use sepg_algo::core::state::State;
+use sepg_algo::solver::PolicySolver;
+
+use crate::error::{Error, Result};
+use crate::folder::{
+    CHECKPOINT_FILE, CONFIG_FILE, Checkpoint, FinalParams, LOG_FILE, PARTIAL_LOG_FILE,
+    SUMMARY_FILE, Summary, Tally, io_fail, is_complete, load_resolved, log_header, log_row,
+    read_summary, to_json_line, write_atomic,
+};
+use crate::spec::{Resolved, VERSION};
+
+/// Receives the progress of a run (iterations) or of a sweep (runs). Every method does
+/// nothing by default; implementations must be shareable across the threads of a sweep.
+pub trait Observer: Sync {
+    /// Called once before the work starts: `done` of `total` units are already done.
+    fn begin(&self, _done: u64, _total: u64) {}
+    /// Called after each unit of work: `done` units are done so far.
+    fn advance(&self, _done: u64) {}
+    /// Called once when the work ends, whether it completed or not.
+    fn end(&self) {}
+}
+
+/// The observer that ignores every report.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Silent;
+
+impl Observer for Silent {}
+
+/// How a run is driven: checkpoint period, stop flag and progress observer.
+#[derive(Clone, Copy)]
+pub struct RunOptions<'a> {
+    /// Iterations between checkpoints (at least 1).
+    pub checkpoint_every: u64,
+    /// When raised, the run stops after its current iteration, checkpoints and returns
+    /// [`Error::Interrupted`].
+    pub stop: &'a AtomicBool,
+    /// Receives the number of iterations done.
+    pub observer: &'a dyn Observer,
+}
+
+/// Starts a new run of `resolved` in `dir` (created if needed; the caller has checked it is
+/// empty, see [`crate::folder::check_out_dir`]) and runs it to completion.
+///
+/// # Errors
+/// [`Error::Failed`] for I/O errors or a failing iteration; [`Error::Interrupted`] when the
+/// stop flag was raised (after checkpointing).
+pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Summary> {
+    fs::create_dir_all(dir).map_err(|e| io_fail("create", dir, e))?;
+    let header = log_header(resolved.dims.0, resolved.dims.1);
+    write_atomic(&dir.join(PARTIAL_LOG_FILE), header.as_bytes())?;
+    let ck = Checkpoint {
+        log_bytes: header.len() as u64,
+        elapsed_s: 0.0,
+        tally: Tally::default(),
+        state: resolved.checked.initial_state(),
+    };
+    write_atomic(&dir.join(CHECKPOINT_FILE), to_json_line(&ck)?.as_bytes())?;
+    // The configuration goes last: a folder with a config.toml always has a checkpoint.
+    write_atomic(&dir.join(CONFIG_FILE), resolved.toml()?.as_bytes())?;
+    drive(dir, resolved, ck, opts)
+}
+
+/// Resumes the run in `dir` from its checkpoint and runs it to completion; a complete run is
+/// returned as is.
+///
+/// # Errors
+/// [`Error::Invalid`] when `dir` is not a resumable run folder; otherwise as [`start`].
+pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
+    let resolved = load_resolved(dir)?;
+    if is_complete(dir) {
+        return read_summary(dir);
+    }
+    let ck_path = dir.join(CHECKPOINT_FILE);
+    let text = fs::read_to_string(&ck_path)
+        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", ck_path.display())))?;
+    let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| {
+        Error::invalid(format!(
+            "{} is not a valid checkpoint: {e}",
+            ck_path.display()
+        ))
+    })?;
+    let partial = dir.join(PARTIAL_LOG_FILE);
+    let finished = dir.join(LOG_FILE);
+    if !partial.exists() && finished.is_file() && ck.state.iteration == resolved.iterations() {
+        // Killed between the final rename and the summary: only the summary is missing.
+        return finish(dir, &resolved, &ck);
+    }
+    truncate_log(&partial, ck.log_bytes)?;
+    drive(dir, &resolved, ck, opts)
+}
+
+/// Cuts the partial log back to the `log_bytes` its checkpoint vouches for.
+fn truncate_log(partial: &Path, log_bytes: u64) -> Result<()> {
+    let file = OpenOptions::new()
+        .write(true)
+        .open(partial)
+        .map_err(|e| Error::invalid(format!("cannot open {}: {e}", partial.display())))?;
+    let len = file
+        .metadata()
+        .map_err(|e| io_fail("read", partial, e))?
+        .len();
+    if len < log_bytes {
+        return Err(Error::invalid(format!(
+            "{} is shorter ({len} bytes) than its checkpoint says ({log_bytes} bytes)",
+            partial.display(),
+        )));
+    }
+    file.set_len(log_bytes)
+        .map_err(|e| io_fail("truncate", partial, e))?;
+    file.sync_all().map_err(|e| io_fail("sync", partial, e))
+}
+
+/// The log being appended to and the checkpoint of the rows already on disk.
+struct Writer {
+    dir: PathBuf,
+    partial: PathBuf,
+    log: File,
+    ck: Checkpoint,
+    chunk: String,
+    segment: Instant,
+}
+
+impl Writer {
+    fn open(dir: &Path, ck: Checkpoint) -> Result<Writer> {
+        let partial = dir.join(PARTIAL_LOG_FILE);
+        let log = OpenOptions::new()
+            .append(true)
+            .open(&partial)
+            .map_err(|e| io_fail("open", &partial, e))?;
+        Ok(Writer {
+            dir: dir.to_path_buf(),
+            partial,
+            log,
+            ck,
+            chunk: String::new(),
+            segment: Instant::now(),
+        })
+    }
+
+    /// Appends the buffered rows to the log, syncs it, and replaces the checkpoint by one for
+    /// `tally` and `state`.
+    fn checkpoint(&mut self, tally: &Tally, state: &State) -> Result<()> {
+        self.log
+            .write_all(self.chunk.as_bytes())
+            .and_then(|()| self.log.sync_data())
+            .map_err(|e| io_fail("write", &self.partial, e))?;
+        self.ck = Checkpoint {
+            log_bytes: self.ck.log_bytes + self.chunk.len() as u64,
+            elapsed_s: self.ck.elapsed_s + self.segment.elapsed().as_secs_f64(),
+            tally: tally.clone(),
+            state: state.clone(),
+        };
+        self.segment = Instant::now();
+        self.chunk.clear();
+        write_atomic(
+            &self.dir.join(CHECKPOINT_FILE),
+            to_json_line(&self.ck)?.as_bytes(),
+        )
+    }
+}
+
+/// Iterates from the checkpoint `ck` to the end of the run, then finishes the folder.
+fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) -> Result<Summary> {
+    let total = resolved.iterations();
+    let every = resolved.log_every();
+    let mut writer = Writer::open(dir, ck)?;
+    let mut solver = PolicySolver::new(&resolved.checked)
+        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+    let mut state = writer.ck.state.clone();
+    if state.iteration == 0 {
+        solver
+            .init(&mut state)
+            .map_err(|e| Error::failed(e.to_string()))?;
+    }
+    opts.observer.begin(state.iteration, total);
+    let mut tally = writer.ck.tally.clone();
+    let period = opts.checkpoint_every.max(1);
+    while state.iteration < total {
+        let record = match solver.next_iter(&mut state) {
+            Ok(r) => r,
+            Err(e) => {
+                opts.observer.end();
+                return Err(Error::failed(format!("{}: {e}", dir.display())));
+            }
+        };
+        tally.add(&record);
+        if record.iteration.is_multiple_of(every) || state.iteration == total {
+            writer.chunk.push_str(&log_row(&record));
+        }
+        opts.observer.advance(state.iteration);
+        let stop = opts.stop.load(Ordering::SeqCst);
+        if state.iteration.is_multiple_of(period) || state.iteration == total || stop {
+            writer.checkpoint(&tally, &state)?;
+            if stop && state.iteration < total {
+                opts.observer.end();
+                return Err(Error::Interrupted {
+                    iteration: state.iteration,
+                    total,
+                    dir: dir.to_path_buf(),
+                });
+            }
+        }
+    }
+    opts.observer.end();
+    let Writer {
+        partial, log, ck, ..
+    } = writer;
+    drop(log);
+    fs::rename(&partial, dir.join(LOG_FILE)).map_err(|e| io_fail("rename", &partial, e))?;
+    finish(dir, resolved, &ck)
+}
+
+/// Writes `summary.json` from the final checkpoint `ck`, completing the run.
+fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
+    let s = &ck.state;
+    let v_star = resolved.v_star();
+    let abs_v_error = v_star.as_ref().map(|vs| {
+        s.v.iter()
+            .zip(vs)
+            .fold(0.0_f64, |m, (v, vs)| m.max((v - vs).abs()))
+    });
+    let wall = ck.elapsed_s;
+    let rate = |x: f64| if wall > 0.0 { x / wall } else { 0.0 };
+    let summary = Summary {
+        status: "complete".into(),
+        name: resolved.spec.name.clone().unwrap_or_default(),
+        sepg_version: VERSION.into(),
+        iterations: s.iteration,
+        final_params: FinalParams {
+            v: s.v.clone(),
+            w: s.w.clone(),
+            sigma: s.sigma(),
+            budget: s.budget,
+        },
+        v_star,
+        abs_v_error,
+        last_j_explore: ck.tally.last_j_explore,
+        last_j_target: ck.tally.last_j_target,
+        infeasible_iterations: ck.tally.infeasible,
+        below_noise_v_iterations: ck.tally.below_noise_v,
+        below_noise_w_iterations: ck.tally.below_noise_w,
+        trajectories: s.trajectories,
+        steps: s.steps,
+        wall_time_s: wall,
+        iterations_per_s: rate(s.iteration as f64),
+        env_steps_per_s: rate(s.steps as f64),
+    };
+    write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
+    Ok(summary)
+}

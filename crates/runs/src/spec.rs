@@ -1,0 +1,830 @@
+//! Run options and their resolution: [`RunSpec`] holds every option of a run (as a TOML
+//! table and, with the `clap` feature, as command-line flags of the same names);
+//! [`RunSpec::resolve`] fills in the defaults of the thesis's protocol (Sec 5.1), rejects
+//! options that do not apply to the chosen algorithm, and validates the result into the
+//! [`CheckedConfig`] that `sepg-algo` runs.
+
+use std::fs;
+use std::path::Path;
+
+#[cfg(feature = "clap")]
+use clap::{Args, ValueEnum};
+use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
+use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
+use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
+use sepg_mdp::mountain_car::MountainCar;
+use sepg_mdp::oracle::ClosedFormOracle;
+use serde::{Deserialize, Deserializer, Serialize};
+
+use crate::error::{Error, Result};
+
+/// The version of sepg recorded in every configuration.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Environment presets accepted by `--env`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvName {
+    /// Thesis Sec 5.1 as written (S, A = [−2, 2], r = −0.5(s² + a²)).
+    Lqg,
+    /// The 1-D LQG behind the thesis's numbers (S, A = [−4, 4], r = −0.9(s² + a²)).
+    Lqg1d,
+    /// Gymnasium's MountainCarContinuous-v0.
+    MountainCar,
+}
+
+impl EnvName {
+    /// The registry name.
+    pub fn name(self) -> &'static str {
+        match self {
+            EnvName::Lqg => "lqg",
+            EnvName::Lqg1d => "lqg1d",
+            EnvName::MountainCar => "mountain-car",
+        }
+    }
+}
+
+/// Algorithms accepted by `--algo`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum AlgoName {
+    /// SEPG, monotonic improvement.
+    SepgMi,
+    /// SEPG, lower-bounded I (split ν).
+    SepgLb1,
+    /// SEPG, lower-bounded II (budget).
+    SepgLb2,
+    /// SEPG, low-variance target.
+    SepgLv,
+    /// SEPG, zero-variance (deterministic) target.
+    SepgZv,
+    /// SEPG with simultaneous updates from one batch (budget split ν).
+    SepgSim,
+    /// SEPG with the naive variance update along ∇_w J (eq. 4.12).
+    SepgNaiveW,
+    /// G(PO)MDP with constant steps α, β.
+    GpomdpConst,
+    /// G(PO)MDP with Adam.
+    GpomdpAdam,
+    /// The adaptive step of Pirotta et al. with fixed σ.
+    Adastep,
+}
+
+impl AlgoName {
+    /// The name of the algorithm in configurations and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            AlgoName::SepgMi => "sepg-mi",
+            AlgoName::SepgLb1 => "sepg-lb1",
+            AlgoName::SepgLb2 => "sepg-lb2",
+            AlgoName::SepgLv => "sepg-lv",
+            AlgoName::SepgZv => "sepg-zv",
+            AlgoName::SepgSim => "sepg-sim",
+            AlgoName::SepgNaiveW => "sepg-naive-w",
+            AlgoName::GpomdpConst => "gpomdp-const",
+            AlgoName::GpomdpAdam => "gpomdp-adam",
+            AlgoName::Adastep => "adastep",
+        }
+    }
+
+    /// Whether the algorithm splits its requirement with ν (LB-I and SIM-ν, Table 4.1, also
+    /// as the requirement of `sepg-naive-w`).
+    fn uses_nu(self, requirement: Option<RequirementName>) -> bool {
+        matches!(self, AlgoName::SepgLb1 | AlgoName::SepgSim)
+            || (self == AlgoName::SepgNaiveW
+                && matches!(
+                    requirement,
+                    Some(RequirementName::Lb1 | RequirementName::Sim)
+                ))
+    }
+}
+
+/// Safety requirements accepted by `--requirement` (the requirement of `sepg-naive-w`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum RequirementName {
+    /// Monotonic improvement.
+    Mi,
+    /// Lower-bounded I.
+    Lb1,
+    /// Lower-bounded II.
+    Lb2,
+    /// Low variance.
+    Lv,
+    /// Zero variance.
+    Zv,
+    /// Simultaneous updates.
+    Sim,
+}
+
+impl RequirementName {
+    /// The requirement of `sepg-algo`, with the split ν of LB-I and SIM-ν (default 0.5).
+    fn requirement(self, nu: Option<f64>) -> Requirement {
+        let nu = nu.unwrap_or(0.5);
+        match self {
+            RequirementName::Mi => Requirement::Mi,
+            RequirementName::Lb1 => Requirement::LbI { nu },
+            RequirementName::Lb2 => Requirement::LbII,
+            RequirementName::Lv => Requirement::Lv,
+            RequirementName::Zv => Requirement::Zv,
+            RequirementName::Sim => Requirement::Sim { nu },
+        }
+    }
+}
+
+/// Gradient modes accepted by `--gradients`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum GradientsName {
+    /// Oracle J and gradients (LQG only).
+    Exact,
+    /// Monte Carlo estimates with confidence level δ.
+    Sampled,
+}
+
+/// Estimators accepted by `--estimator`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum EstimatorName {
+    /// G(PO)MDP.
+    Gpomdp,
+    /// REINFORCE.
+    Reinforce,
+    /// PGT (reward-to-go order).
+    Pgt,
+}
+
+/// Baselines accepted by `--baseline`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum BaselineName {
+    /// No baseline.
+    None,
+    /// Mean baseline.
+    Mean,
+    /// Variance-optimal baseline.
+    Optimal,
+}
+
+/// Baseline fits accepted by `--baseline-fit`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum FitName {
+    /// Each trajectory's baseline is fitted on the others (unbiased).
+    LeaveOneOut,
+    /// One baseline from the whole batch.
+    PlugIn,
+}
+
+/// One value broadcast to every component, or one value per component.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Values {
+    /// The same value for every component.
+    One(f64),
+    /// One value per component.
+    Many(Vec<f64>),
+}
+
+impl Values {
+    fn expand(&self, dim: usize, what: &str) -> Result<Vec<f64>> {
+        match self {
+            Values::One(x) => Ok(vec![*x; dim]),
+            Values::Many(v) if v.len() == 1 => Ok(vec![v[0]; dim]),
+            Values::Many(v) if v.len() == dim => Ok(v.clone()),
+            Values::Many(v) => Err(Error::invalid(format!(
+                "{what} has {} values, the environment needs 1 or {dim}",
+                v.len()
+            ))),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Values {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            One(f64),
+            Many(Vec<f64>),
+        }
+        match Raw::deserialize(d) {
+            Ok(Raw::One(x)) => Ok(Values::One(x)),
+            Ok(Raw::Many(v)) => Ok(Values::Many(v)),
+            Err(_) => Err(serde::de::Error::custom(
+                "expected a number or an array of numbers",
+            )),
+        }
+    }
+}
+
+/// Parses the command-line form of [`Values`]: one number, or numbers separated by commas.
+///
+/// # Errors
+/// A message naming the text when a part is not a number.
+pub fn parse_values(s: &str) -> Result<Values, String> {
+    let v: Result<Vec<f64>, _> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
+    match v {
+        Ok(v) if v.len() == 1 => Ok(Values::One(v[0])),
+        Ok(v) => Ok(Values::Many(v)),
+        Err(e) => Err(format!(
+            "{s:?} is not a comma-separated list of numbers: {e}"
+        )),
+    }
+}
+
+/// Every option of a run, as flags of `sepg run` and as keys of a TOML file (the same names).
+/// Absent options take the defaults of the thesis's protocol (Sec 5.1); a resolved configuration has every option
+/// that applies to its algorithm set and no other.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(Args))]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct RunSpec {
+    /// A label for the run (used in legends). Default: the algorithm's name.
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Environment [default: lqg].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub env: Option<EnvName>,
+    /// Mountain Car features: `state-bias` (default) or `rbf:KxV` (a K×V grid plus bias).
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub features: Option<String>,
+    /// Algorithm [default: sepg-zv].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub algo: Option<AlgoName>,
+    /// Safety requirement of sepg-naive-w [default: zv].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub requirement: Option<RequirementName>,
+    /// Exact (oracle) or sampled gradients [default: sampled].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gradients: Option<GradientsName>,
+    /// Confidence δ ∈ (0, 1) of the sampled mode [default: 0.2].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta: Option<f64>,
+    /// Split ν ∈ [0, 1] of LB-I (share of C for w) and SIM (share of B for v) [default: 0.5].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nu: Option<f64>,
+    /// Initial mean parameters v⁰: one value for all, or comma-separated [default: -0.1].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_values))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub v0: Option<Values>,
+    /// Initial standard deviations σ⁰ > 0: one value for all, or comma-separated [default: 1].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_values))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma0: Option<Values>,
+    /// Initial budget B⁰ ≥ 0 [default: 0; 1 for mountain-car].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub budget0: Option<f64>,
+    /// Step size α of v (gpomdp-const).
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// Step size β of w (gpomdp-const) [default: α].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// Learning rate of v (gpomdp-adam).
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lr: Option<f64>,
+    /// Learning rate of w (gpomdp-adam) [default: lr].
+    #[cfg_attr(feature = "clap", arg(long = "lr-w", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lr_w: Option<f64>,
+    /// Trajectories per iteration N [default: 100].
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub batch: Option<usize>,
+    /// Horizon H [default: 20; 999 for mountain-car].
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horizon: Option<usize>,
+    /// Iterations [default: 10000].
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<u64>,
+    /// Seed [default: 0].
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Gradient estimator of the sampled mode [default: gpomdp].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorName>,
+    /// Baseline of the estimator [default: optimal].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineName>,
+    /// How the baseline is fitted [default: leave-one-out].
+    #[cfg_attr(feature = "clap", arg(long = "baseline-fit", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline_fit: Option<FitName>,
+    /// Write every k-th iteration to the log (and always the last) [default: 1].
+    #[cfg_attr(feature = "clap", arg(long = "log-every"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log_every: Option<u64>,
+    /// Version of sepg that resolved the configuration (written by sepg; checked on resume).
+    #[cfg_attr(feature = "clap", arg(skip))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sepg_version: Option<String>,
+}
+
+macro_rules! overlay_fields {
+    ($base:ident, $top:ident; $($f:ident),*) => {
+        RunSpec { $($f: $top.$f.clone().or_else(|| $base.$f.clone()),)* }
+    };
+}
+
+impl RunSpec {
+    /// This specification with every option set in `top` replacing the same option here.
+    pub fn overlay(&self, top: &RunSpec) -> RunSpec {
+        let base = self;
+        overlay_fields!(base, top; name, env, features, algo, requirement, gradients, delta, nu,
+            v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
+            estimator, baseline, baseline_fit, log_every, sepg_version)
+    }
+
+    /// Reads a TOML file of options; unknown keys are rejected.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a missing or unreadable file or an invalid key or value.
+    pub fn from_file(path: &Path) -> Result<RunSpec> {
+        let text = fs::read_to_string(path)
+            .map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
+        toml::from_str(&text)
+            .map_err(|e| Error::invalid(format!("{}: {}", path.display(), toml_message(&e))))
+    }
+
+    /// Resolves every default, validates the configuration (the checks of
+    /// [`SepgConfig::check`] plus the options that do not apply to the algorithm) and builds
+    /// the algorithm's configuration.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for any invalid or inapplicable option.
+    pub fn resolve(&self) -> Result<Resolved> {
+        let env_name = self.env.unwrap_or(EnvName::Lqg);
+        let algo = self.algo.unwrap_or(AlgoName::SepgZv);
+        let gradients = self.gradients.unwrap_or(GradientsName::Sampled);
+        let env = build_env(env_name, self.features.as_deref())?;
+        let features = match env_name {
+            EnvName::MountainCar => {
+                Some(self.features.clone().unwrap_or_else(|| "state-bias".into()))
+            }
+            _ => {
+                reject(self.features.is_some(), "features", "to LQG environments")?;
+                None
+            }
+        };
+        self.reject_inapplicable(algo, gradients)?;
+        let method = self.method(algo)?;
+        let sampling = self.sampling(gradients);
+        let dim_w = env.action_dim();
+        let dim_v = dim_w * env.feature_dim();
+        let start = self.start(env_name, dim_v, dim_w)?;
+        let schedule = self.schedule(env.constants().horizon)?;
+        let config = SepgConfig {
+            env,
+            algorithm: method.algorithm,
+            gradient: sampling.gradient(),
+            estimator: sampling.gradient_spec(),
+            v0: start.v0.clone(),
+            sigma0: start.sigma0.clone(),
+            n_trajectories: schedule.batch,
+            horizon: schedule.horizon,
+            iterations: schedule.iterations,
+            seed: schedule.seed,
+            initial_budget: start.budget0,
+        };
+        let checked = config
+            .check()
+            .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+        let spec = RunSpec {
+            name: Some(self.name.clone().unwrap_or_else(|| algo.name().to_owned())),
+            env: Some(env_name),
+            features,
+            algo: Some(algo),
+            gradients: Some(gradients),
+            sepg_version: Some(
+                self.sepg_version
+                    .clone()
+                    .unwrap_or_else(|| VERSION.to_owned()),
+            ),
+            ..RunSpec::resolved_values(&method, &sampling, start, &schedule)
+        };
+        Ok(Resolved {
+            spec,
+            checked,
+            dims: (dim_v, dim_w),
+        })
+    }
+
+    /// Rejects the options that do not apply to `algo` or to `gradients`.
+    fn reject_inapplicable(&self, algo: AlgoName, gradients: GradientsName) -> Result<()> {
+        let for_algo = format!("to algorithm {}", algo.name());
+        reject(
+            !algo.uses_nu(self.requirement) && self.nu.is_some(),
+            "nu",
+            &for_algo,
+        )?;
+        reject(
+            algo != AlgoName::SepgNaiveW && self.requirement.is_some(),
+            "requirement",
+            &for_algo,
+        )?;
+        reject(
+            algo != AlgoName::GpomdpConst && (self.alpha.is_some() || self.beta.is_some()),
+            "alpha/beta",
+            &for_algo,
+        )?;
+        reject(
+            algo != AlgoName::GpomdpAdam && (self.lr.is_some() || self.lr_w.is_some()),
+            "lr/lr-w",
+            &for_algo,
+        )?;
+        let exact = gradients == GradientsName::Exact;
+        reject(exact && self.delta.is_some(), "delta", "to exact gradients")?;
+        reject(
+            exact
+                && (self.estimator.is_some()
+                    || self.baseline.is_some()
+                    || self.baseline_fit.is_some()),
+            "estimator/baseline/baseline-fit",
+            "to exact gradients",
+        )
+    }
+
+    /// The algorithm of `algo` with its step options (the options were checked to apply).
+    fn method(&self, algo: AlgoName) -> Result<Method> {
+        let nu = algo
+            .uses_nu(self.requirement)
+            .then(|| self.nu.unwrap_or(0.5));
+        let requirement =
+            (algo == AlgoName::SepgNaiveW).then(|| self.requirement.unwrap_or(RequirementName::Zv));
+        let need = |v: Option<f64>, flag: &str| {
+            v.ok_or_else(|| Error::invalid(format!("algorithm {} needs --{flag}", algo.name())))
+        };
+        let mut method = Method {
+            algorithm: Algorithm::AdaStep,
+            requirement,
+            nu,
+            alpha: None,
+            beta: None,
+            lr: None,
+            lr_w: None,
+        };
+        let sepg = |r: RequirementName| Algorithm::Sepg(r.requirement(nu));
+        method.algorithm = match algo {
+            AlgoName::SepgMi => sepg(RequirementName::Mi),
+            AlgoName::SepgLb1 => sepg(RequirementName::Lb1),
+            AlgoName::SepgLb2 => sepg(RequirementName::Lb2),
+            AlgoName::SepgLv => sepg(RequirementName::Lv),
+            AlgoName::SepgZv => sepg(RequirementName::Zv),
+            AlgoName::SepgSim => sepg(RequirementName::Sim),
+            AlgoName::SepgNaiveW => {
+                Algorithm::SepgNaiveW(requirement.unwrap_or(RequirementName::Zv).requirement(nu))
+            }
+            AlgoName::GpomdpConst => {
+                let alpha = need(self.alpha, "alpha")?;
+                let beta = self.beta.unwrap_or(alpha);
+                (method.alpha, method.beta) = (Some(alpha), Some(beta));
+                Algorithm::GpomdpConst { alpha, beta }
+            }
+            AlgoName::GpomdpAdam => {
+                let lr = need(self.lr, "lr")?;
+                let lr_w = self.lr_w.unwrap_or(lr);
+                (method.lr, method.lr_w) = (Some(lr), Some(lr_w));
+                Algorithm::adam(lr, lr_w)
+            }
+            AlgoName::Adastep => Algorithm::AdaStep,
+        };
+        Ok(method)
+    }
+
+    /// The confidence and estimator of the sampled mode (`None` for exact gradients).
+    fn sampling(&self, gradients: GradientsName) -> Sampling {
+        if gradients == GradientsName::Exact {
+            return Sampling(None);
+        }
+        Sampling(Some((
+            self.delta.unwrap_or(0.2),
+            self.estimator.unwrap_or(EstimatorName::Gpomdp),
+            self.baseline.unwrap_or(BaselineName::Optimal),
+            self.baseline_fit.unwrap_or(FitName::LeaveOneOut),
+        )))
+    }
+
+    /// The initial parameters and budget for an environment with `dim_v` mean parameters and
+    /// `dim_w` standard deviations.
+    fn start(&self, env: EnvName, dim_v: usize, dim_w: usize) -> Result<Start> {
+        let v0 = self
+            .v0
+            .clone()
+            .unwrap_or(Values::One(-0.1))
+            .expand(dim_v, "v0")?;
+        let sigma0 = self
+            .sigma0
+            .clone()
+            .unwrap_or(Values::One(1.0))
+            .expand(dim_w, "sigma0")?;
+        let budget0 = self.budget0.unwrap_or(if env == EnvName::MountainCar {
+            1.0
+        } else {
+            0.0
+        });
+        Ok(Start {
+            v0,
+            sigma0,
+            budget0,
+        })
+    }
+
+    /// Batch size, horizon (default: the environment's `default_horizon`), iterations, seed
+    /// and log stride.
+    fn schedule(&self, default_horizon: usize) -> Result<Schedule> {
+        let batch = self.batch.unwrap_or(100);
+        if batch < 2 {
+            return Err(Error::invalid(format!(
+                "batch N = {batch} must be at least 2"
+            )));
+        }
+        let log_every = self.log_every.unwrap_or(1);
+        let schedule = Schedule {
+            batch,
+            horizon: self.horizon.unwrap_or(default_horizon),
+            iterations: self.iterations.unwrap_or(10_000),
+            seed: self.seed.unwrap_or(0),
+            log_every,
+        };
+        if log_every == 0 {
+            return Err(Error::invalid("log-every must be at least 1"));
+        }
+        Ok(schedule)
+    }
+
+    /// The resolved options that come from the parts of [`RunSpec::resolve`] (every other
+    /// option is `None`).
+    fn resolved_values(
+        method: &Method,
+        sampling: &Sampling,
+        start: Start,
+        schedule: &Schedule,
+    ) -> RunSpec {
+        let one_or_many = |v: Vec<f64>| {
+            if v.len() == 1 {
+                Values::One(v[0])
+            } else {
+                Values::Many(v)
+            }
+        };
+        let estimator = sampling.0.map(|(_, k, b, f)| (k, b, f));
+        RunSpec {
+            requirement: method.requirement,
+            delta: sampling.0.map(|s| s.0),
+            nu: method.nu,
+            v0: Some(one_or_many(start.v0)),
+            sigma0: Some(one_or_many(start.sigma0)),
+            budget0: Some(start.budget0),
+            alpha: method.alpha,
+            beta: method.beta,
+            lr: method.lr,
+            lr_w: method.lr_w,
+            batch: Some(schedule.batch),
+            horizon: Some(schedule.horizon),
+            iterations: Some(schedule.iterations),
+            seed: Some(schedule.seed),
+            estimator: estimator.map(|e| e.0),
+            baseline: estimator.map(|e| e.1),
+            baseline_fit: estimator.map(|e| e.2),
+            log_every: Some(schedule.log_every),
+            ..RunSpec::default()
+        }
+    }
+}
+
+/// `Err` naming the option `what` and why it does not apply, when `set`.
+fn reject(set: bool, what: &str, why: &str) -> Result<()> {
+    if set {
+        Err(Error::invalid(format!(
+            "option {what} does not apply {why}"
+        )))
+    } else {
+        Ok(())
+    }
+}
+
+/// The algorithm of a run and the step options it uses.
+struct Method {
+    algorithm: Algorithm,
+    requirement: Option<RequirementName>,
+    nu: Option<f64>,
+    alpha: Option<f64>,
+    beta: Option<f64>,
+    lr: Option<f64>,
+    lr_w: Option<f64>,
+}
+
+/// δ, estimator, baseline and fit of the sampled mode; `None` for exact gradients.
+struct Sampling(Option<(f64, EstimatorName, BaselineName, FitName)>);
+
+impl Sampling {
+    fn gradient(&self) -> GradientMode {
+        match self.0 {
+            Some((delta, ..)) => GradientMode::Sampled { delta },
+            None => GradientMode::Exact,
+        }
+    }
+
+    fn gradient_spec(&self) -> GradientSpec {
+        self.0
+            .map_or_else(GradientSpec::default, |(_, k, b, f)| GradientSpec {
+                kind: match k {
+                    EstimatorName::Gpomdp => Kind::Gpomdp,
+                    EstimatorName::Reinforce => Kind::Reinforce,
+                    EstimatorName::Pgt => Kind::Pgt,
+                },
+                baseline: match b {
+                    BaselineName::None => Baseline::None,
+                    BaselineName::Mean => Baseline::Mean,
+                    BaselineName::Optimal => Baseline::Optimal,
+                },
+                fit: match f {
+                    FitName::LeaveOneOut => BaselineFit::LeaveOneOut,
+                    FitName::PlugIn => BaselineFit::PlugIn,
+                },
+            })
+    }
+}
+
+/// Initial parameters v⁰, σ⁰ and budget B⁰.
+struct Start {
+    v0: Vec<f64>,
+    sigma0: Vec<f64>,
+    budget0: f64,
+}
+
+/// Batch size, horizon, iterations, seed and log stride.
+struct Schedule {
+    batch: usize,
+    horizon: usize,
+    iterations: u64,
+    seed: u64,
+    log_every: u64,
+}
+
+/// The first line of a TOML error, without the source excerpt.
+pub fn toml_message(e: &toml::de::Error) -> String {
+    let msg = e.message().trim().to_owned();
+    match e.span() {
+        Some(span) => format!("{msg} (at byte {})", span.start),
+        None => msg,
+    }
+}
+
+fn build_env(name: EnvName, features: Option<&str>) -> Result<AnyEnv> {
+    Ok(match name {
+        EnvName::Lqg => AnyEnv::Lqg(Box::new(LqgEnv::thesis())),
+        EnvName::Lqg1d => AnyEnv::Lqg(Box::new(LqgEnv::lqg1d())),
+        EnvName::MountainCar => AnyEnv::MountainCar(match features.unwrap_or("state-bias") {
+            "state-bias" => MountainCar::state_bias(),
+            f => {
+                let bad =
+                    || Error::invalid(format!("features {f:?}: expected state-bias or rbf:KxV"));
+                let grid = f.strip_prefix("rbf:").ok_or_else(bad)?;
+                let (k, v) = grid.split_once('x').ok_or_else(bad)?;
+                let k: usize = k.parse().map_err(|_| bad())?;
+                let v: usize = v.parse().map_err(|_| bad())?;
+                MountainCar::rbf([k, v], true)
+                    .map_err(|e| Error::invalid(format!("features {f:?}: {e}")))?
+            }
+        }),
+    })
+}
+
+/// A fully resolved and validated run configuration.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    /// Every option that applies, with its value (what `config.toml` holds).
+    pub spec: RunSpec,
+    /// The validated configuration of the algorithm.
+    pub checked: CheckedConfig,
+    /// Number of mean parameters and of standard deviations.
+    pub dims: (usize, usize),
+}
+
+impl Resolved {
+    /// The resolved configuration as TOML text.
+    ///
+    /// # Errors
+    /// [`Error::Failed`] if serialisation fails.
+    pub fn toml(&self) -> Result<String> {
+        toml::to_string(&self.spec)
+            .map_err(|e| Error::failed(format!("cannot serialise the configuration: {e}")))
+    }
+
+    /// v* of the LQG environments (the unclipped infinite-horizon optimum of the closed-form oracle), `None`
+    /// for other environments.
+    pub fn v_star(&self) -> Option<Vec<f64>> {
+        match &self.checked.config().env {
+            AnyEnv::Lqg(e) => ClosedFormOracle::new(e.model())
+                .ok()?
+                .optimal_gain()
+                .ok()
+                .map(|g| g.v),
+            AnyEnv::MountainCar(_) => None,
+        }
+    }
+
+    /// Number of iterations of the run.
+    pub fn iterations(&self) -> u64 {
+        self.checked.config().iterations
+    }
+
+    /// Row stride of the log.
+    pub fn log_every(&self) -> u64 {
+        self.spec.log_every.unwrap_or(1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolving_a_resolved_configuration_changes_nothing() {
+        let spec = RunSpec {
+            env: Some(EnvName::Lqg1d),
+            algo: Some(AlgoName::GpomdpAdam),
+            lr: Some(1e-5),
+            sigma0: Some(Values::One(0.1)),
+            ..RunSpec::default()
+        };
+        let once = spec.resolve().expect("valid");
+        let text = once.toml().expect("toml");
+        let again: RunSpec = toml::from_str(&text).expect("parse");
+        let twice = again.resolve().expect("valid");
+        assert_eq!(once.spec, twice.spec);
+        assert_eq!(once.checked, twice.checked);
+        assert_eq!(twice.spec.lr_w, Some(1e-5));
+    }
+
+    #[test]
+    fn inapplicable_options_are_rejected() {
+        let spec = RunSpec {
+            algo: Some(AlgoName::SepgZv),
+            alpha: Some(0.1),
+            ..RunSpec::default()
+        };
+        assert!(spec.resolve().is_err());
+        let spec = RunSpec {
+            gradients: Some(GradientsName::Exact),
+            delta: Some(0.1),
+            ..RunSpec::default()
+        };
+        assert!(spec.resolve().is_err());
+        let spec = RunSpec {
+            algo: Some(AlgoName::GpomdpConst),
+            ..RunSpec::default()
+        };
+        assert!(spec.resolve().is_err());
+    }
+
+    #[test]
+    fn algorithm_names_are_the_configuration_names() {
+        let all = [
+            AlgoName::SepgMi,
+            AlgoName::SepgLb1,
+            AlgoName::SepgLb2,
+            AlgoName::SepgLv,
+            AlgoName::SepgZv,
+            AlgoName::SepgSim,
+            AlgoName::SepgNaiveW,
+            AlgoName::GpomdpConst,
+            AlgoName::GpomdpAdam,
+            AlgoName::Adastep,
+        ];
+        for algo in all {
+            let spec = RunSpec {
+                algo: Some(algo),
+                ..RunSpec::default()
+            };
+            let text = toml::to_string(&spec).expect("toml");
+            assert_eq!(text.trim(), format!("algo = \"{}\"", algo.name()));
+        }
+    }
+}

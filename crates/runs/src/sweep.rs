@@ -1,0 +1,394 @@
+//! Sweeps: every (preset, variant, σ⁰, seed) combination of a sweep file, run in parallel
+//! into one run folder each, optionally restricted to a shard `I/N` (the runs whose
+//! index mod N is I) so that a cluster job array can split the work.
+//!
+//! # Sweep file
+//! ```toml
+//! presets = ["lqg", "lqg1d"]
+//! seeds = 10                 # seeds 0..9, or an explicit list [1, 5, 9]
+//! sigma0 = [0.1, 0.5, 1.0]
+//! [base]                     # options shared by every run (the keys of `sepg run`)
+//! iterations = 2000
+//! [[variant]]
+//! name = "zv"
+//! algo = "sepg-zv"
+//! [[variant]]
+//! name = "adam-1e-4"
+//! algo = "gpomdp-adam"
+//! lr = 1e-4
+//! ```
+//! Runs are numbered preset-major, then variant, σ⁰ and seed; run `i` lives in
+//! `runs/<preset>/<variant>/sigma-<σ⁰>/seed-<seed>`. `sweep.json` records the sweep, its
+//! identifier (a hash of every resolved run configuration), the run list and the shard.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::folder::{CONFIG_FILE, check_out_dir, is_complete, to_json_line, write_atomic};
+use crate::run::{self, Observer, RunOptions, Silent};
+use crate::spec::{EnvName, Resolved, RunSpec, Values, toml_message};
+
+/// The sweep description file.
+pub const SWEEP_FILE: &str = "sweep.json";
+/// Folder of the run folders inside a sweep folder.
+pub const RUNS_DIR: &str = "runs";
+
+/// Seeds of a sweep: a count (seeds 0..count) or an explicit list.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Seeds {
+    /// Seeds `0, 1, …, count − 1`.
+    Count(u64),
+    /// These seeds.
+    List(Vec<u64>),
+}
+
+impl Seeds {
+    fn list(&self) -> Vec<u64> {
+        match self {
+            Seeds::Count(n) => (0..*n).collect(),
+            Seeds::List(v) => v.clone(),
+        }
+    }
+}
+
+/// A sweep: the product presets × variants × σ⁰ × seeds over a base configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct SweepSpec {
+    /// Environments.
+    pub presets: Vec<EnvName>,
+    /// Seeds.
+    pub seeds: Seeds,
+    /// Initial standard deviations σ⁰ (one value each, for every action dimension).
+    pub sigma0: Vec<f64>,
+    /// Options shared by every run.
+    #[serde(default)]
+    pub base: RunSpec,
+    /// The variants (each a set of run options with a unique `name`).
+    pub variant: Vec<RunSpec>,
+}
+
+/// One run of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunEntry {
+    /// Index in the sweep (preset-major, then variant, σ⁰, seed).
+    pub index: usize,
+    /// Environment.
+    pub preset: EnvName,
+    /// Variant name.
+    pub variant: String,
+    /// Initial standard deviation.
+    pub sigma0: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Run folder relative to the sweep folder.
+    pub dir: String,
+}
+
+/// Which runs of the sweep a folder holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// Shard index I.
+    pub index: usize,
+    /// Number of shards N (1: the whole sweep).
+    pub count: usize,
+}
+
+/// `sweep.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepFile {
+    /// Hash of every resolved run configuration (FNV-1a, hex): equal iff the sweeps are.
+    pub sweep_id: String,
+    /// The sweep.
+    pub spec: SweepSpec,
+    /// Every run of the sweep (all shards).
+    pub runs: Vec<RunEntry>,
+    /// The runs this folder holds.
+    pub shard: Shard,
+    /// Number of shard folders merged into this one (0 if it was run directly).
+    pub merged_from: usize,
+}
+
+impl SweepFile {
+    /// The runs of the shard.
+    pub fn shard_runs(&self) -> impl Iterator<Item = &RunEntry> {
+        self.runs
+            .iter()
+            .filter(|r| r.index % self.shard.count == self.shard.index)
+    }
+
+    /// Reads `sweep.json` of a sweep folder.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] when the folder has no valid `sweep.json`.
+    pub fn read(dir: &Path) -> Result<SweepFile> {
+        let p = dir.join(SWEEP_FILE);
+        let text = std::fs::read_to_string(&p)
+            .map_err(|e| Error::invalid(format!("{} is not a sweep folder: {e}", dir.display())))?;
+        serde_json::from_str(&text)
+            .map_err(|e| Error::invalid(format!("{} is invalid: {e}", p.display())))
+    }
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+fn path_safe(name: &str) -> bool {
+    !name.is_empty()
+        && name != "."
+        && name != ".."
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+}
+
+/// Expands a sweep into its resolved runs and `sweep.json` contents (for shard `shard`).
+///
+/// # Errors
+/// [`Error::Invalid`] for an empty axis, a duplicate or unsafe variant name, a variant or
+/// base that sets a sweep axis (env, seed, sigma0), or any run whose configuration is invalid.
+pub fn expand(spec: &SweepSpec, shard: Shard) -> Result<(SweepFile, Vec<Resolved>)> {
+    let seeds = spec.seeds.list();
+    if spec.presets.is_empty()
+        || seeds.is_empty()
+        || spec.sigma0.is_empty()
+        || spec.variant.is_empty()
+    {
+        return Err(Error::invalid(
+            "a sweep needs at least one preset, seed, sigma0 and variant",
+        ));
+    }
+    let axis = |s: &RunSpec| s.env.is_some() || s.seed.is_some() || s.sigma0.is_some();
+    if axis(&spec.base) || spec.variant.iter().any(axis) {
+        return Err(Error::invalid(
+            "env, seed and sigma0 are sweep axes (presets, seeds, sigma0), not run options",
+        ));
+    }
+    let names = variant_names(&spec.variant)?;
+    let mut runs = Vec::new();
+    let mut resolved = Vec::new();
+    let mut hash_input = String::new();
+    for &preset in &spec.presets {
+        for (variant, name) in spec.variant.iter().zip(&names) {
+            for &sigma0 in &spec.sigma0 {
+                for &seed in &seeds {
+                    let r = resolve_run(&spec.base, variant, name, preset, sigma0, seed)?;
+                    hash_input.push_str(&r.toml()?);
+                    runs.push(RunEntry {
+                        index: runs.len(),
+                        preset,
+                        variant: name.clone(),
+                        sigma0,
+                        seed,
+                        dir: format!(
+                            "{RUNS_DIR}/{}/{name}/sigma-{sigma0:?}/seed-{seed}",
+                            preset.name()
+                        ),
+                    });
+                    resolved.push(r);
+                }
+            }
+        }
+    }
+    let file = SweepFile {
+        sweep_id: format!("{:016x}", fnv1a(hash_input.as_bytes())),
+        spec: spec.clone(),
+        runs,
+        shard,
+        merged_from: 0,
+    };
+    Ok((file, resolved))
+}
+
+/// The name of each variant (its `name`, else its algorithm's), checked to be unique and
+/// usable as a folder name.
+fn variant_names(variants: &[RunSpec]) -> Result<Vec<String>> {
+    let mut names: Vec<String> = Vec::new();
+    for v in variants {
+        let name = v
+            .name
+            .clone()
+            .or_else(|| v.algo.map(|a| a.name().to_owned()))
+            .ok_or_else(|| Error::invalid("every variant needs a name or an algo"))?;
+        if !path_safe(&name) {
+            return Err(Error::invalid(format!(
+                "variant name {name:?} must use only letters, digits, '-', '_', '.'"
+            )));
+        }
+        if names.contains(&name) {
+            return Err(Error::invalid(format!(
+                "variant name {name:?} appears twice"
+            )));
+        }
+        names.push(name);
+    }
+    Ok(names)
+}
+
+/// The resolved run of `variant` (named `name`) over `base` at one point of the axes.
+fn resolve_run(
+    base: &RunSpec,
+    variant: &RunSpec,
+    name: &str,
+    preset: EnvName,
+    sigma0: f64,
+    seed: u64,
+) -> Result<Resolved> {
+    let axes = RunSpec {
+        name: Some(name.to_owned()),
+        env: Some(preset),
+        sigma0: Some(Values::One(sigma0)),
+        seed: Some(seed),
+        ..RunSpec::default()
+    };
+    base.overlay(variant).overlay(&axes).resolve().map_err(|e| {
+        Error::invalid(format!(
+            "variant {name} on {} with sigma0 {sigma0}: {e}",
+            preset.name()
+        ))
+    })
+}
+
+/// Parses `I/N` with `0 ≤ I < N`.
+///
+/// # Errors
+/// [`Error::Invalid`] for anything else.
+pub fn parse_shard(s: &str) -> Result<Shard> {
+    let bad = || Error::invalid(format!("--shard {s:?}: expected I/N with 0 <= I < N"));
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let index: usize = i.trim().parse().map_err(|_| bad())?;
+    let count: usize = n.trim().parse().map_err(|_| bad())?;
+    if count == 0 || index >= count {
+        return Err(bad());
+    }
+    Ok(Shard { index, count })
+}
+
+/// Reads a sweep file.
+///
+/// # Errors
+/// [`Error::Invalid`] for a missing file or an invalid key or value.
+pub fn read_spec(path: &Path) -> Result<SweepSpec> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
+    toml::from_str(&text)
+        .map_err(|e| Error::invalid(format!("{}: {}", path.display(), toml_message(&e))))
+}
+
+/// Throughput of a finished sweep.
+#[derive(Debug, Clone, Copy)]
+pub struct SweepStats {
+    /// Runs executed (or resumed) by this call.
+    pub runs: usize,
+    /// Iterations executed by this call.
+    pub iterations: u64,
+    /// Wall time in seconds.
+    pub wall_s: f64,
+}
+
+/// How a sweep is driven: checkpoint period of each run, stop flag and progress observer.
+#[derive(Clone, Copy)]
+pub struct SweepOptions<'a> {
+    /// Iterations between checkpoints of each run (at least 1).
+    pub checkpoint_every: u64,
+    /// When raised, every run stops after its current iteration and checkpoints.
+    pub stop: &'a AtomicBool,
+    /// Receives the number of runs finished.
+    pub observer: &'a dyn Observer,
+}
+
+/// Runs every incomplete run of the shard in `dir` (which holds `file` as `sweep.json`), in
+/// parallel over runs.
+///
+/// # Errors
+/// The first run's failure (after every other run has stopped at a checkpoint).
+pub fn execute(
+    dir: &Path,
+    file: &SweepFile,
+    resolved: &[Resolved],
+    opts: SweepOptions<'_>,
+) -> Result<SweepStats> {
+    let todo: Vec<(&RunEntry, &Resolved)> = file
+        .shard_runs()
+        .map(|r| (r, &resolved[r.index]))
+        .filter(|(r, _)| !is_complete(&dir.join(&r.dir)))
+        .collect();
+    let total: u64 = todo.iter().map(|(_, r)| r.iterations()).sum();
+    opts.observer.begin(0, todo.len() as u64);
+    let run_opts = RunOptions {
+        checkpoint_every: opts.checkpoint_every,
+        stop: opts.stop,
+        observer: &Silent,
+    };
+    let finished = AtomicU64::new(0);
+    let start = Instant::now();
+    let results: Vec<Result<()>> = todo
+        .par_iter()
+        .map(|(entry, res)| {
+            let run_dir = dir.join(&entry.dir);
+            let out = if run_dir.join(CONFIG_FILE).is_file() {
+                run::resume(&run_dir, run_opts)
+            } else {
+                run::start(&run_dir, res, run_opts)
+            };
+            opts.observer
+                .advance(finished.fetch_add(1, Ordering::SeqCst) + 1);
+            out.map(|_| ())
+        })
+        .collect();
+    opts.observer.end();
+    if let Some(Err(e)) = results.into_iter().find(Result::is_err) {
+        return Err(e);
+    }
+    Ok(SweepStats {
+        runs: todo.len(),
+        iterations: total,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Creates the sweep folder `dir` with `sweep.json` and runs it.
+///
+/// # Errors
+/// As [`execute`], and [`Error::Invalid`] for a non-empty folder without `force`.
+pub fn start(
+    dir: &Path,
+    file: &SweepFile,
+    resolved: &[Resolved],
+    force: bool,
+    opts: SweepOptions<'_>,
+) -> Result<SweepStats> {
+    check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR])?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Error::failed(format!("cannot create {}: {e}", dir.display())))?;
+    write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())?;
+    execute(dir, file, resolved, opts)
+}
+
+/// Resumes the sweep in `dir`: re-expands its `sweep.json` with this version of sepg, checks
+/// that it describes the same runs, and runs the incomplete ones.
+///
+/// # Errors
+/// [`Error::Invalid`] when `dir` is not a sweep folder or was written by a version of sepg
+/// that resolves it differently; otherwise as [`execute`].
+pub fn resume(dir: &Path, opts: SweepOptions<'_>) -> Result<(SweepFile, SweepStats)> {
+    let file = SweepFile::read(dir)?;
+    let (expected, resolved) = expand(&file.spec, file.shard)?;
+    if expected.sweep_id != file.sweep_id {
+        return Err(Error::invalid(format!(
+            "{} was written by another sepg version (sweep id differs)",
+            dir.join(SWEEP_FILE).display()
+        )));
+    }
+    let stats = execute(dir, &file, &resolved, opts)?;
+    Ok((file, stats))
+}

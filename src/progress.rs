@@ -1,0 +1,64 @@
+//! Progress bars on standard error and the Ctrl-C handler: the terminal side of the
+//! observer and stop flag that `sepg-runs` takes.
+
+use std::io::IsTerminal;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sepg_runs::run::Observer;
+
+/// Raised by SIGINT: every running loop stops after its current iteration and checkpoints.
+pub static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Installs the SIGINT handler that raises [`STOP`] (once per process).
+pub fn install_interrupt_handler() {
+    static ONCE: OnceLock<()> = OnceLock::new();
+    ONCE.get_or_init(|| {
+        // Without a handler (e.g. one is already installed) Ctrl-C keeps its default
+        // action; the checkpoints still leave the folder consistent.
+        let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::SeqCst));
+    });
+}
+
+/// A progress bar on standard error, shown only when asked for and standard error is a
+/// terminal.
+pub struct Bar(ProgressBar);
+
+impl Bar {
+    /// A bar counting iterations of one run.
+    pub fn iterations(show: bool) -> Bar {
+        Bar::new(show, "{bar:40} {pos}/{len} it  {per_sec}  eta {eta}")
+    }
+
+    /// A bar counting the runs of a sweep.
+    pub fn runs(show: bool) -> Bar {
+        Bar::new(show, "{bar:40} {pos}/{len} runs  eta {eta}")
+    }
+
+    fn new(show: bool, template: &str) -> Bar {
+        if !(show && std::io::stderr().is_terminal()) {
+            return Bar(ProgressBar::hidden());
+        }
+        let pb = ProgressBar::new(0);
+        if let Ok(style) = ProgressStyle::with_template(template) {
+            pb.set_style(style);
+        }
+        Bar(pb)
+    }
+}
+
+impl Observer for Bar {
+    fn begin(&self, done: u64, total: u64) {
+        self.0.set_length(total);
+        self.0.set_position(done);
+    }
+
+    fn advance(&self, done: u64) {
+        self.0.set_position(done);
+    }
+
+    fn end(&self) {
+        self.0.finish_and_clear();
+    }
+}
