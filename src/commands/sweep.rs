@@ -1,6 +1,7 @@
 //! `sepg sweep`: every (preset, variant, σ⁰, seed) combination of a sweep file, run in
 //! parallel into one run folder each, optionally restricted to a shard `I/N` (the runs whose
-//! index mod N is I) so that a cluster job array can split the work. The sweep file format
+//! index mod N is I) so that a cluster job array can split the work (`--shard slurm` reads
+//! I and N from a Slurm job array, see docs/CLUSTER.md). The sweep file format
 //! is documented in [`sepg_runs::sweep`].
 
 use std::path::{Path, PathBuf};
@@ -20,8 +21,10 @@ pub struct SweepArgs {
     /// Output sweep folder (must be absent or empty unless --force).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Run only shard I of N: the runs whose index mod N equals I.
-    #[arg(long, value_name = "I/N")]
+    /// Run only shard I of N: the runs whose index mod N equals I. `slurm` takes I and N from
+    /// the Slurm job array of this task (SLURM_ARRAY_TASK_ID minus SLURM_ARRAY_TASK_MIN, and
+    /// SLURM_ARRAY_TASK_COUNT).
+    #[arg(long, value_name = "I/N|slurm")]
     shard: Option<String>,
     /// Write into a non-empty folder, replacing a previous sweep's files there.
     #[arg(long)]
@@ -89,6 +92,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             .ok_or_else(|| CliError::usage("--config FILE.toml is required"))?;
         let spec = sweep::read_spec(path)?;
         let shard = match &args.shard {
+            Some(s) if s == "slurm" => sweep::slurm_shard(|k| std::env::var(k).ok())?,
             Some(s) => sweep::parse_shard(s)?,
             None => Shard { index: 0, count: 1 },
         };

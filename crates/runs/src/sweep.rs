@@ -273,6 +273,51 @@ pub fn parse_shard(s: &str) -> Result<Shard> {
     Ok(Shard { index, count })
 }
 
+/// The shard of this task of a Slurm job array: `I = (SLURM_ARRAY_TASK_ID −
+/// SLURM_ARRAY_TASK_MIN) / SLURM_ARRAY_TASK_STEP` and `N = SLURM_ARRAY_TASK_COUNT`, so that an
+/// array `--array=A-B` of any first index A (step 1, or a uniform step) numbers its tasks
+/// 0, 1, …, N − 1. `SLURM_ARRAY_TASK_MIN` defaults to 0 and `SLURM_ARRAY_TASK_STEP` to 1
+/// when absent. `var` looks a variable up (`std::env::var` on a cluster; a map in tests).
+///
+/// # Errors
+/// [`Error::Invalid`] naming the variable when `SLURM_ARRAY_TASK_ID` or
+/// `SLURM_ARRAY_TASK_COUNT` is absent, a variable is not a non-negative integer (the step
+/// must be positive), or the task does not map to a shard `0 ≤ I < N` (an array with gaps,
+/// such as `--array=1,5,9`).
+pub fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<Shard> {
+    let read = |name: &str, default: Option<usize>| -> Result<usize> {
+        match (var(name), default) {
+            (Some(text), _) => text.trim().parse::<usize>().map_err(|_| {
+                Error::invalid(format!(
+                    "--shard slurm: {name}={text:?} is not a non-negative integer"
+                ))
+            }),
+            (None, Some(d)) => Ok(d),
+            (None, None) => Err(Error::invalid(format!(
+                "--shard slurm: {name} is not set (run inside a Slurm job array: sbatch --array=0-N)"
+            ))),
+        }
+    };
+    let id = read("SLURM_ARRAY_TASK_ID", None)?;
+    let count = read("SLURM_ARRAY_TASK_COUNT", None)?;
+    let min = read("SLURM_ARRAY_TASK_MIN", Some(0))?;
+    let step = read("SLURM_ARRAY_TASK_STEP", Some(1))?;
+    if step == 0 {
+        return Err(Error::invalid(
+            "--shard slurm: SLURM_ARRAY_TASK_STEP=0 is not a positive integer",
+        ));
+    }
+    let offset = id.checked_sub(min).filter(|o| o % step == 0);
+    match offset.map(|o| o / step) {
+        Some(index) if index < count => Ok(Shard { index, count }),
+        _ => Err(Error::invalid(format!(
+            "--shard slurm: task {id} of an array of {count} tasks from {min} by {step} is not \
+             one of tasks 0..{count}; use a range without gaps, e.g. --array=0-{}",
+            count.saturating_sub(1)
+        ))),
+    }
+}
+
 /// Reads a sweep file.
 ///
 /// # Errors
@@ -391,4 +436,91 @@ pub fn resume(dir: &Path, opts: SweepOptions<'_>) -> Result<(SweepFile, SweepSta
     }
     let stats = execute(dir, &file, &resolved, opts)?;
     Ok((file, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+
+    use super::*;
+
+    fn slurm(vars: &[(&str, &str)]) -> Result<Shard> {
+        let map: HashMap<String, String> = vars
+            .iter()
+            .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
+            .collect();
+        slurm_shard(|k| map.get(k).cloned())
+    }
+
+    #[test]
+    fn slurm_arrays_number_their_tasks_from_zero() {
+        let shard = |index, count| Shard { index, count };
+        // --array=0-3, task 2.
+        let vars = [
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
+        assert_eq!(slurm(&vars).expect("valid"), shard(2, 4));
+        // --array=1-4: ids 1..=4 are shards 0..=3.
+        for id in 1..=4 {
+            let id_text = id.to_string();
+            let vars = [
+                ("SLURM_ARRAY_TASK_ID", id_text.as_str()),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+                ("SLURM_ARRAY_TASK_MIN", "1"),
+            ];
+            assert_eq!(slurm(&vars).expect("valid"), shard(id - 1, 4));
+        }
+        // --array=10-16:3: ids 10, 13, 16 are shards 0, 1, 2.
+        let vars = [
+            ("SLURM_ARRAY_TASK_ID", "16"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "10"),
+            ("SLURM_ARRAY_TASK_STEP", "3"),
+        ];
+        assert_eq!(slurm(&vars).expect("valid"), shard(2, 3));
+    }
+
+    #[test]
+    fn slurm_variables_that_do_not_give_a_shard_are_named() {
+        let message = |vars: &[(&str, &str)]| match slurm(vars) {
+            Err(Error::Invalid(m)) => m,
+            other => panic!("expected an invalid-input error, got {other:?}"),
+        };
+        let m = message(&[("SLURM_ARRAY_TASK_COUNT", "4")]);
+        assert!(m.contains("SLURM_ARRAY_TASK_ID is not set"), "{m}");
+        let m = message(&[("SLURM_ARRAY_TASK_ID", "0")]);
+        assert!(m.contains("SLURM_ARRAY_TASK_COUNT is not set"), "{m}");
+        let m = message(&[
+            ("SLURM_ARRAY_TASK_ID", "x"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        assert!(m.contains("SLURM_ARRAY_TASK_ID=\"x\""), "{m}");
+        let m = message(&[
+            ("SLURM_ARRAY_TASK_ID", "-1"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        assert!(m.contains("not a non-negative integer"), "{m}");
+        // Ids starting at 1 without SLURM_ARRAY_TASK_MIN: task 4 of 4 is out of range.
+        let m = message(&[
+            ("SLURM_ARRAY_TASK_ID", "4"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        assert!(m.contains("--array=0-3"), "{m}");
+        // An id below the minimum, a step that is zero, an array with gaps, no tasks.
+        for vars in [
+            [("SLURM_ARRAY_TASK_ID", "0"), ("SLURM_ARRAY_TASK_MIN", "1")],
+            [("SLURM_ARRAY_TASK_ID", "1"), ("SLURM_ARRAY_TASK_STEP", "0")],
+            [("SLURM_ARRAY_TASK_ID", "5"), ("SLURM_ARRAY_TASK_MIN", "1")],
+            [
+                ("SLURM_ARRAY_TASK_ID", "0"),
+                ("SLURM_ARRAY_TASK_COUNT", "0"),
+            ],
+        ] {
+            let mut all = vec![("SLURM_ARRAY_TASK_COUNT", "3")];
+            all.extend(vars);
+            // Later entries override the count above.
+            assert!(slurm(&all).is_err(), "{vars:?}");
+        }
+    }
 }
