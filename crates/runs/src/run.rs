@@ -268,3 +268,71 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     Ok(summary)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::RunSpec;
+
+    /// Raises the stop flag once `at` iterations are done, as Ctrl-C would.
+    struct StopAt<'a> {
+        at: u64,
+        stop: &'a AtomicBool,
+    }
+
+    impl Observer for StopAt<'_> {
+        fn advance(&self, done: u64) {
+            if done == self.at {
+                self.stop.store(true, Ordering::SeqCst);
+            }
+        }
+    }
+
+    #[test]
+    fn a_stopped_run_resumes_to_the_log_of_an_uninterrupted_one() {
+        let resolved = RunSpec {
+            iterations: Some(9),
+            batch: Some(10),
+            algo: Some(crate::spec::AlgoName::SepgLb2),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid");
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let (whole, parts) = (tmp.path().join("whole"), tmp.path().join("parts"));
+        let never = AtomicBool::new(false);
+        let plain = RunOptions {
+            checkpoint_every: 4,
+            stop: &never,
+            observer: &Silent,
+        };
+        start(&whole, &resolved, plain).expect("complete run");
+
+        let stop = AtomicBool::new(false);
+        let observer = StopAt { at: 3, stop: &stop };
+        let stopping = RunOptions {
+            observer: &observer,
+            stop: &stop,
+            ..plain
+        };
+        // Stopped between two checkpoints (every 4): the run checkpoints at iteration 3.
+        match start(&parts, &resolved, stopping) {
+            Err(Error::Interrupted {
+                iteration: 3,
+                total: 9,
+                dir,
+            }) => assert_eq!(dir, parts),
+            other => panic!("expected an interruption at 3 of 9, got {other:?}"),
+        }
+        assert!(!is_complete(&parts));
+        let ck: Checkpoint = serde_json::from_str(
+            &fs::read_to_string(parts.join(CHECKPOINT_FILE)).expect("checkpoint"),
+        )
+        .expect("json");
+        assert_eq!(ck.state.iteration, 3);
+        let summary = resume(&parts, plain).expect("resumed run");
+        assert_eq!(summary.iterations, 9);
+        let log = |d: &Path| fs::read(d.join(LOG_FILE)).expect("log");
+        assert_eq!(log(&parts), log(&whole));
+    }
+}
