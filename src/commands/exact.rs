@@ -29,7 +29,7 @@ pub struct ExactArgs {
     /// unclipped closed form, 20 with --clipped.
     #[arg(long)]
     horizon: Option<HorizonArg>,
-    /// Standard deviation η₀ ≥ 0 of the transition noise (default 0, SPEC §1).
+    /// Standard deviation η₀ ≥ 0 of the transition noise (default 0: the presets are noiseless).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     eta: f64,
     /// Use the clipped model (state and action boxes of the preset), evaluated by dynamic

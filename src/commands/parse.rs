@@ -5,7 +5,7 @@ use std::str::FromStr;
 use sepg_mdp::LqgModel;
 use sepg_mdp::oracle::Horizon;
 
-/// A 1-D LQG preset name (SPEC §1).
+/// A 1-D LQG preset name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LqgPreset {
     /// `lqg`: thesis Sec 5.1 as written (S, A = [−2, 2], reward −0.5(s² + a²)).

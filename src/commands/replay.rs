@@ -1,5 +1,5 @@
 //! `sepg replay`: the trajectory of an environment from a given state under a given action
-//! sequence (Mountain Car, gymnasium `MountainCarContinuous-v0` rules of SPEC §1).
+//! sequence (Mountain Car, the rules of gymnasium's `MountainCarContinuous-v0`).
 
 use clap::Args;
 use sepg_mdp::env::Environment;
