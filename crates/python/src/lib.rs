@@ -2,6 +2,8 @@
 //!
 //! - [`bounds`]: every closed-form quantity of `sepg_bounds` (Chapters 3 and 4 of the thesis).
 //! - [`envs`]: transitions of the built-in environments, for cross-checks against gymnasium.
+//! - [`runs`]: run folders, sweeps (also mapped over Dask or Ray from Python), merges and
+//!   audits of the built-in environments through `sepg_runs`.
 //! - [`safe`]: the framework-agnostic safe-step API: gradient estimates, per-trajectory
 //!   samples or confidence widths in, SEPG's safe steps, guarantees and flags out
 //!   (Theorems 4.2–4.9).
@@ -17,6 +19,7 @@ use sepg_bounds::constants::TaskConstants;
 
 pub mod bounds;
 pub mod envs;
+pub mod runs;
 pub mod safe;
 pub mod train;
 
@@ -139,6 +142,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTaskConstants>()?;
     bounds::register(m)?;
     envs::register(m)?;
+    runs::register(m)?;
     safe::register(m)?;
     train::register(m)?;
     Ok(())

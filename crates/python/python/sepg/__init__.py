@@ -8,6 +8,8 @@
 - :mod:`sepg.gym`: SEPG and the comparison algorithms on any gymnasium environment with a
   ``Box`` action space (imported on demand; needs ``gymnasium``).
 - :class:`Trainer`: the same algorithms on batches collected by any Python callable.
+- :mod:`sepg.runs`: run folders, sweeps (mapped over Dask or Ray), merges and audits of the
+  built-in environments, as the command line writes them.
 
 Errors are the classes of :mod:`sepg.errors`; bad input raises
 :class:`~sepg.errors.InvalidInputError`, a ``ValueError``.
@@ -17,7 +19,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from sepg import bounds, errors
+from sepg import bounds, errors, runs
 from sepg._native import (
     mountain_car_trajectory,
     BatchRequest,
@@ -148,6 +150,7 @@ __all__ = [
     "records_to_arrays",
     "records_to_pandas",
     "required_improvement",
+    "runs",
     "v_step",
     "w_step",
 ]
