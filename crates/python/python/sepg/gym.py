@@ -1,0 +1,363 @@
+"""SEPG and the comparison algorithms on gymnasium environments.
+
+The policy is the factored linear Gaussian policy of the thesis (Sec 4.3.1, 4.3.4),
+``a ~ N(V phi(s), diag(sigma^2))``, on features ``phi`` given by a Python callable (the
+observation itself by default). Trajectories are collected here in Python, by stepping the
+environment; the scores, the gradient estimates and their confidence widths (Sec 4.5), the
+safe steps (Theorems 4.2-4.9) and the budget (Definition 4.3) are computed by the Rust
+algorithms, the same code as the command line's runs.
+
+Seeds follow gymnasium's conventions: trajectory ``i`` of a block starts with
+``env.reset(seed=s_i)`` and draws its action noise from
+``numpy.random.default_rng(p_i)``, where ``s_i`` and ``p_i`` derive from
+``(seed, iteration, block, i)``. A run is therefore reproducible bit for bit, and a vector
+environment gives the same records as a single one.
+
+The bounds need the task constants: the discount ``gamma``, ``r_max`` (a bound on
+``|r|``), ``m_phi`` (a bound on ``|phi_i(s)|``) and ``action_volume`` (the volume ``|A|`` of
+the action space). A constant not given is derived from the spaces when it can be (``|A|``
+from a bounded ``Box`` action space, ``M_phi`` from a bounded observation space with the
+default identity features, ``R_max`` from a finite ``reward_range``), and the derivation is
+shown; otherwise :class:`sepg.errors.MissingConstantError` says what to pass.
+"""
+
+import json
+import math
+import sys
+import time
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from sepg._native import BatchRequest, TaskConstants, Trainer
+from sepg.errors import InvalidInputError, MissingConstantError
+from sepg import records_to_arrays, records_to_pandas
+
+Features = Callable[[np.ndarray], Any]
+
+
+def _gymnasium() -> Any:
+    try:
+        import gymnasium
+    except ImportError as e:  # pragma: no cover - exercised only without gymnasium
+        raise InvalidInputError(
+            "sepg.gym needs gymnasium: pip install gymnasium"
+        ) from e
+    return gymnasium
+
+
+def _spaces(env: Any) -> Tuple[Any, Any, int]:
+    """(action space, observation space, number of sub-environments) of an env or a vector
+    env."""
+    gymnasium = _gymnasium()
+    if isinstance(env, gymnasium.vector.VectorEnv):
+        return env.single_action_space, env.single_observation_space, int(env.num_envs)
+    if isinstance(env, gymnasium.Env):
+        return env.action_space, env.observation_space, 0
+    raise InvalidInputError(
+        f"env must be a gymnasium Env, a gymnasium VectorEnv or an environment id, got {type(env).__name__}"
+    )
+
+
+def _name(env: Any) -> str:
+    spec = getattr(env, "spec", None)
+    return spec.id if spec is not None and getattr(spec, "id", None) else type(env).__name__
+
+
+def derive_constants(
+    env: Any,
+    *,
+    gamma: float,
+    r_max: Optional[float] = None,
+    m_phi: Optional[float] = None,
+    action_volume: Optional[float] = None,
+    features: Optional[Features] = None,
+) -> Tuple[TaskConstants, List[str]]:
+    """The task constants of ``env`` and the derivation of those that were not given.
+
+    ``|A|`` is the product of ``high - low`` of a bounded ``Box`` action space; ``M_phi`` is
+    ``max(|low|, |high|)`` over a bounded ``Box`` observation space when the features are the
+    observation itself (``features=None``); ``R_max`` is ``max(|lo|, |hi|)`` of a finite
+    ``reward_range``. Raises :class:`MissingConstantError` naming every constant that is
+    neither given nor derivable, and :class:`InvalidInputError` for a non-``Box`` action space.
+    """
+    gymnasium = _gymnasium()
+    action_space, obs_space, _ = _spaces(env)
+    if not isinstance(action_space, gymnasium.spaces.Box):
+        raise InvalidInputError(
+            f"SEPG's Gaussian policy needs a Box action space; {_name(env)} has {action_space}"
+        )
+    derivation: List[str] = []
+    missing: List[str] = []
+    name = _name(env)
+    if action_volume is None:
+        low = np.asarray(action_space.low, dtype=float)
+        high = np.asarray(action_space.high, dtype=float)
+        if np.all(np.isfinite(low)) and np.all(np.isfinite(high)):
+            action_volume = float(np.prod(high - low))
+            derivation.append(
+                f"|A| = prod(high - low) = {action_volume:g} from the action space "
+                f"Box(low={low.tolist()}, high={high.tolist()}) of {name}"
+            )
+        else:
+            missing.append("action_volume (|A|: the action space is unbounded)")
+    if m_phi is None:
+        bounded_obs = isinstance(obs_space, gymnasium.spaces.Box) and np.all(
+            np.isfinite(obs_space.low)
+        ) and np.all(np.isfinite(obs_space.high))
+        if features is None and bounded_obs:
+            m_phi = float(
+                max(np.max(np.abs(obs_space.low)), np.max(np.abs(obs_space.high)))
+            )
+            derivation.append(
+                f"M_phi = max |bound| = {m_phi:g} of the observation space "
+                f"Box(low={np.asarray(obs_space.low).tolist()}, high={np.asarray(obs_space.high).tolist()}), "
+                "the features being the observation"
+            )
+        elif features is None:
+            missing.append("m_phi (M_phi: the observation space is unbounded)")
+        else:
+            missing.append("m_phi (M_phi: a bound on |phi_i(s)| of the given features)")
+    if r_max is None:
+        reward_range = getattr(getattr(env, "unwrapped", env), "reward_range", None)
+        if reward_range is not None and all(math.isfinite(x) for x in reward_range):
+            r_max = float(max(abs(reward_range[0]), abs(reward_range[1])))
+            derivation.append(
+                f"R_max = max |reward_range| = {r_max:g} from reward_range {tuple(reward_range)} of {name}"
+            )
+        else:
+            missing.append(f"r_max (R_max: {name} declares no finite reward range)")
+    if missing:
+        raise MissingConstantError(
+            "the safety bounds need constants that cannot be derived from the spaces; pass "
+            + "; ".join(missing)
+        )
+    return TaskConstants(gamma, r_max, m_phi, action_volume), derivation
+
+
+class _Collector:
+    """Collects the batches a :class:`sepg.Trainer` asks for by stepping a gymnasium env."""
+
+    def __init__(self, env: Any, features: Features, horizon: int, actions: int, n_features: int):
+        self.env = env
+        self.features = features
+        self.horizon = horizon
+        self.actions = actions
+        self.n_features = n_features
+        self.steps = 0
+        self.seconds = 0.0
+
+    def phi(self, obs: Any) -> np.ndarray:
+        phi = np.asarray(self.features(obs), dtype=float).reshape(-1)
+        if phi.shape[0] != self.n_features:
+            raise InvalidInputError(
+                f"features returned {phi.shape[0]} values, earlier {self.n_features}"
+            )
+        return phi
+
+    def __call__(self, req: BatchRequest) -> Tuple[np.ndarray, Optional[np.ndarray], Optional[np.ndarray], np.ndarray]:
+        start = time.perf_counter()
+        n, h, l, p = req.n, self.horizon, self.actions, self.n_features
+        mean = req.mean
+        sigma = None if req.sigma is None else np.asarray(req.sigma)
+        rewards = np.zeros((n, h))
+        actions = np.zeros((n, h, l)) if req.scores else None
+        feats = np.zeros((n, h, p)) if req.scores else None
+        lengths = np.zeros(n, dtype=np.int64)
+        record = (rewards, actions, feats, lengths)
+        k = getattr(self.env, "num_envs", None)
+        if k is None:
+            for i in range(n):
+                self._single(req, i, mean, sigma, record)
+        else:
+            for first in range(0, n, int(k)):
+                self._group(req, first, min(n, first + int(k)), mean, sigma, record)
+        self.steps += int(lengths.sum())
+        self.seconds += time.perf_counter() - start
+        return record
+
+    def _single(self, req: BatchRequest, i: int, mean: np.ndarray, sigma: Optional[np.ndarray], record: Any) -> None:
+        rewards, actions, feats, lengths = record
+        obs, _ = self.env.reset(seed=int(req.env_seeds[i]))
+        rng = np.random.default_rng(int(req.policy_seeds[i]))
+        t = 0
+        while t < self.horizon:
+            phi = self.phi(obs)
+            a = mean @ phi
+            if sigma is not None:
+                a = a + sigma * rng.standard_normal(self.actions)
+            obs, r, terminated, truncated, _ = self.env.step(a)
+            rewards[i, t] = float(r)
+            if actions is not None:
+                actions[i, t] = a
+                feats[i, t] = phi
+            t += 1
+            if terminated or truncated:
+                break
+        lengths[i] = t
+
+    def _group(self, req: BatchRequest, first: int, end: int, mean: np.ndarray, sigma: Optional[np.ndarray], record: Any) -> None:
+        rewards, actions, feats, lengths = record
+        k, m = int(self.env.num_envs), end - first
+        seeds = [int(s) for s in req.env_seeds[first:end]] + [0] * (k - m)
+        obs, _ = self.env.reset(seed=seeds)
+        rngs = [np.random.default_rng(int(s)) for s in req.policy_seeds[first:end]]
+        alive = np.zeros(k, dtype=bool)
+        alive[:m] = True
+        lengths[first:end] = self.horizon
+        for t in range(self.horizon):
+            phi = np.stack([self.phi(o) for o in obs])
+            a = phi @ mean.T
+            if sigma is not None:
+                noise = np.zeros((k, self.actions))
+                for j in range(m):
+                    noise[j] = rngs[j].standard_normal(self.actions)
+                a = a + sigma * noise
+            obs, r, terminated, truncated, _ = self.env.step(a)
+            for j in np.flatnonzero(alive):
+                rewards[first + j, t] = float(r[j])
+                if actions is not None:
+                    actions[first + j, t] = a[j]
+                    feats[first + j, t] = phi[j]
+                if terminated[j] or truncated[j]:
+                    alive[j] = False
+                    lengths[first + j] = t + 1
+            if not alive.any():
+                break
+
+
+class GymRun:
+    """A run of SEPG (or a comparison algorithm) on a gymnasium environment.
+
+    ``env`` is a gymnasium ``Env``, a ``VectorEnv`` (trajectories are collected
+    ``num_envs`` at a time) or an environment id for ``gymnasium.make``. ``features`` maps an
+    observation to the feature vector phi(s) (default: the observation itself). ``algorithm``
+    is named as on the command line (``sepg-zv``, ``sepg-lv``, ``sepg-mi``, ``sepg-lb1``,
+    ``sepg-lb2``, ``sepg-sim``, ``sepg-naive-w``, ``gpomdp-const``, ``gpomdp-adam``,
+    ``adastep``); ``options`` are its hyper-parameters (``nu``, ``requirement``, ``alpha``,
+    ``beta``, ``lr``, ``lr_w``). ``horizon`` defaults to the environment's
+    ``max_episode_steps``.
+    """
+
+    def __init__(
+        self,
+        env: Any,
+        features: Optional[Features] = None,
+        *,
+        gamma: float,
+        algorithm: str = "sepg-zv",
+        n_trajectories: int = 100,
+        horizon: Optional[int] = None,
+        r_max: Optional[float] = None,
+        m_phi: Optional[float] = None,
+        action_volume: Optional[float] = None,
+        seed: int = 0,
+        delta: float = 0.2,
+        v0: Optional[Sequence[float]] = None,
+        sigma0: Optional[Sequence[float]] = None,
+        initial_budget: float = 0.0,
+        show_derivation: bool = True,
+        **options: Any,
+    ) -> None:
+        gymnasium = _gymnasium()
+        if isinstance(env, str):
+            env = gymnasium.make(env)
+        self.env = env
+        action_space, obs_space, _ = _spaces(env)
+        self.constants, self.derivation = derive_constants(
+            env,
+            gamma=gamma,
+            r_max=r_max,
+            m_phi=m_phi,
+            action_volume=action_volume,
+            features=features,
+        )
+        if show_derivation:
+            for line in self.derivation:
+                print(f"sepg: {line}", file=sys.stderr)
+        if features is None:
+            features = lambda obs: np.asarray(obs, dtype=float).reshape(-1)  # noqa: E731
+        if horizon is None:
+            spec = getattr(env, "spec", None)
+            horizon = getattr(spec, "max_episode_steps", None)
+            if horizon is None:
+                raise InvalidInputError(
+                    f"{_name(env)} has no max_episode_steps: pass horizon"
+                )
+        if not isinstance(horizon, int) or horizon < 1:
+            raise InvalidInputError(f"horizon must be a positive integer, got {horizon!r}")
+        if not isinstance(action_space, gymnasium.spaces.Box) or len(action_space.shape) != 1:
+            raise InvalidInputError(
+                f"the action space must be a one-dimensional Box, got {action_space}"
+            )
+        self.actions = int(action_space.shape[0])
+        probe = np.asarray(
+            obs_space.sample() if not hasattr(obs_space, "low") else np.clip(0.0, obs_space.low, obs_space.high),
+            dtype=float,
+        )
+        try:
+            phi = np.asarray(features(probe), dtype=float).reshape(-1)
+        except Exception as e:
+            raise InvalidInputError(f"features failed on an observation: {e}") from e
+        if phi.shape[0] == 0:
+            raise InvalidInputError("features must return at least one value")
+        self.n_features = int(phi.shape[0])
+        self.collector = _Collector(env, features, horizon, self.actions, self.n_features)
+        self.trainer = Trainer(
+            algorithm,
+            self.constants,
+            self.actions,
+            self.n_features,
+            self.collector,
+            n_trajectories=n_trajectories,
+            seed=seed,
+            delta=delta,
+            v0=None if v0 is None else np.asarray(v0, dtype=float),
+            sigma0=None if sigma0 is None else np.asarray(sigma0, dtype=float),
+            initial_budget=initial_budget,
+            **options,
+        )
+        self.records: List[Dict[str, Any]] = []
+
+    def run(self, iterations: int) -> Dict[str, np.ndarray]:
+        """Runs ``iterations`` more iterations; returns every record so far as arrays
+        (:func:`sepg.records_to_arrays`)."""
+        if not isinstance(iterations, int) or iterations < 0:
+            raise InvalidInputError(f"iterations must be a non-negative integer, got {iterations!r}")
+        self.records.extend(json.loads(self.trainer.run(iterations)))
+        return records_to_arrays(self.records)
+
+    @property
+    def state(self) -> Dict[str, Any]:
+        """The state after the last iteration: ``v`` (action-major), ``w``, ``budget``, ..."""
+        return json.loads(self.trainer.state())
+
+    @property
+    def mean(self) -> np.ndarray:
+        """The current mean matrix V, shape ``(actions, features)``."""
+        return np.asarray(self.state["v"], dtype=float).reshape(self.actions, self.n_features)
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """The current standard deviations sigma = exp(w)."""
+        return np.exp(np.asarray(self.state["w"], dtype=float))
+
+    @property
+    def steps_per_second(self) -> float:
+        """Environment steps per second of wall-clock time spent collecting trajectories."""
+        return self.collector.steps / self.collector.seconds if self.collector.seconds > 0 else 0.0
+
+    def to_pandas(self) -> Any:
+        """The records as a pandas DataFrame (needs pandas)."""
+        return records_to_pandas(self.records)
+
+
+def train(env: Any, features: Optional[Features] = None, *, iterations: int, **kwargs: Any) -> GymRun:
+    """Builds a :class:`GymRun` and runs ``iterations`` iterations; returns the run (its
+    ``records``, ``mean``, ``sigma``, ``derivation``, ``steps_per_second``)."""
+    run = GymRun(env, features, **kwargs)
+    run.run(iterations)
+    return run
+
+
+__all__ = ["GymRun", "derive_constants", "train"]

@@ -1,0 +1,330 @@
+//! Run folders, sweeps, merges and audits of built-in environments through `sepg_runs`, the
+//! library behind `sepg run`, `sepg sweep`, `sepg merge` and `sepg audit`: the same folders,
+//! byte for byte. Options are passed as JSON text with the keys of the command line
+//! (`sepg.run` builds it from keyword arguments). The GIL is released while runs execute, and
+//! Ctrl-C stops a run at its next iteration after checkpointing (the folder can be resumed).
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use pyo3::prelude::*;
+use pyo3::types::PyModule;
+use sepg_runs::Error;
+use sepg_runs::folder::{self, Log, RUN_FILES};
+use sepg_runs::run::{self, Observer, RunOptions};
+use sepg_runs::spec::RunSpec;
+use sepg_runs::sweep::{self, Shard, SweepFile, SweepOptions, SweepSpec};
+
+use crate::{failed, invalid};
+
+/// Raises the stop flag of a run when Python has a pending signal (Ctrl-C), keeping the
+/// exception to re-raise it once the run has checkpointed.
+struct SignalWatch {
+    stop: AtomicBool,
+    error: Mutex<Option<PyErr>>,
+}
+
+impl SignalWatch {
+    fn new() -> Self {
+        SignalWatch {
+            stop: AtomicBool::new(false),
+            error: Mutex::new(None),
+        }
+    }
+
+    /// The Python error for `e`: the pending signal's exception when the run stopped for
+    /// it, else [`invalid`] for bad input and [`failed`] otherwise.
+    fn error(&self, e: Error) -> PyErr {
+        if let Some(err) = self.error.lock().ok().and_then(|mut s| s.take()) {
+            return err;
+        }
+        if e.is_invalid_input() {
+            invalid(e)
+        } else {
+            failed(e)
+        }
+    }
+}
+
+impl Observer for SignalWatch {
+    fn advance(&self, _done: u64) {
+        Python::attach(|py| {
+            if let Err(e) = py.check_signals() {
+                if let Ok(mut slot) = self.error.lock() {
+                    slot.get_or_insert(e);
+                }
+                self.stop.store(true, Ordering::SeqCst);
+            }
+        });
+    }
+}
+
+fn json<T: serde::Serialize>(value: &T) -> PyResult<String> {
+    serde_json::to_string(value).map_err(failed)
+}
+
+fn checkpoint_period(k: u64) -> PyResult<u64> {
+    if k == 0 {
+        Err(invalid("checkpoint_every must be at least 1"))
+    } else {
+        Ok(k)
+    }
+}
+
+/// Starts a run of a built-in environment into the folder `out` (absent or empty unless
+/// `force`) and runs it to completion; returns `summary.json` as text. `options` is a JSON
+/// object with the keys of `sepg run` (`env`, `algo`, `iterations`, `batch`, `seed`, ...),
+/// overriding those of the TOML file `config` when given.
+#[pyfunction]
+#[pyo3(signature = (out, options, config = None, force = false, checkpoint_every = 500))]
+fn run_folder(
+    py: Python<'_>,
+    out: PathBuf,
+    options: &str,
+    config: Option<PathBuf>,
+    force: bool,
+    checkpoint_every: u64,
+) -> PyResult<String> {
+    let top: RunSpec = serde_json::from_str(options).map_err(|e| invalid(format!("{e}")))?;
+    let base = match &config {
+        Some(path) => RunSpec::from_file(path).map_err(invalid)?,
+        None => RunSpec::default(),
+    };
+    let spec = RunSpec {
+        sepg_version: None,
+        ..base.overlay(&top)
+    };
+    let resolved = spec.resolve().map_err(invalid)?;
+    folder::check_out_dir(&out, force, &RUN_FILES).map_err(invalid)?;
+    let watch = SignalWatch::new();
+    let every = checkpoint_period(checkpoint_every)?;
+    let summary = py.detach(|| {
+        run::start(
+            &out,
+            &resolved,
+            RunOptions {
+                checkpoint_every: every,
+                stop: &watch.stop,
+                observer: &watch,
+            },
+        )
+    });
+    json(&summary.map_err(|e| watch.error(e))?)
+}
+
+/// Resumes the run in `dir` from its checkpoint (a complete run is returned as is); returns
+/// `summary.json` as text.
+#[pyfunction]
+#[pyo3(signature = (dir, checkpoint_every = 500))]
+fn resume_folder(py: Python<'_>, dir: PathBuf, checkpoint_every: u64) -> PyResult<String> {
+    let watch = SignalWatch::new();
+    let every = checkpoint_period(checkpoint_every)?;
+    let summary = py.detach(|| {
+        run::resume(
+            &dir,
+            RunOptions {
+                checkpoint_every: every,
+                stop: &watch.stop,
+                observer: &watch,
+            },
+        )
+    });
+    json(&summary.map_err(|e| watch.error(e))?)
+}
+
+/// The contents of a run folder: `(config, columns, rows, summary)` with the configuration
+/// and the summary as JSON text (`None` for an incomplete run's summary), the log's column
+/// names, and its rows with empty cells (not applicable) as `None`. An incomplete run gives
+/// the rows its checkpoint vouches for.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn read_folder(
+    dir: PathBuf,
+) -> PyResult<(String, Vec<String>, Vec<Vec<Option<f64>>>, Option<String>)> {
+    let resolved = folder::load_resolved(&dir).map_err(invalid)?;
+    let log = Log::read_run(&dir).map_err(invalid)?;
+    let rows = log
+        .rows
+        .iter()
+        .map(|r| r.iter().map(|x| (!x.is_nan()).then_some(*x)).collect())
+        .collect();
+    let summary = if folder::is_complete(&dir) {
+        Some(json(&folder::read_summary(&dir).map_err(failed)?)?)
+    } else {
+        None
+    };
+    Ok((json(&resolved.spec)?, log.columns, rows, summary))
+}
+
+fn parse_sweep(spec: &str) -> PyResult<SweepSpec> {
+    serde_json::from_str(spec).map_err(|e| invalid(format!("invalid sweep: {e}")))
+}
+
+fn parse_shard(shard: Option<&str>) -> PyResult<Shard> {
+    match shard {
+        Some(s) => sweep::parse_shard(s).map_err(invalid),
+        None => Ok(Shard { index: 0, count: 1 }),
+    }
+}
+
+/// Runs the sweep `spec` (JSON with the keys of a sweep file: `presets`, `seeds`, `sigma0`,
+/// `base`, `variant`) into `out`, the runs in parallel on this machine, optionally only
+/// shard `"I/N"`; returns `sweep.json` as text.
+#[pyfunction]
+#[pyo3(signature = (out, spec, shard = None, force = false, checkpoint_every = 2000))]
+fn sweep_folder(
+    py: Python<'_>,
+    out: PathBuf,
+    spec: &str,
+    shard: Option<&str>,
+    force: bool,
+    checkpoint_every: u64,
+) -> PyResult<String> {
+    let (file, resolved) =
+        sweep::expand(&parse_sweep(spec)?, parse_shard(shard)?).map_err(invalid)?;
+    let watch = SignalWatch::new();
+    let every = checkpoint_period(checkpoint_every)?;
+    py.detach(|| {
+        sweep::start(
+            &out,
+            &file,
+            &resolved,
+            force,
+            SweepOptions {
+                checkpoint_every: every,
+                stop: &watch.stop,
+                observer: &watch,
+            },
+        )
+    })
+    .map_err(|e| watch.error(e))?;
+    json(&file)
+}
+
+/// Creates the sweep folder `out` with its `sweep.json` without running anything, so that
+/// the runs can be mapped over a cluster engine with [`sweep_run`]; returns the indices of
+/// the shard's runs.
+#[pyfunction]
+#[pyo3(signature = (out, spec, shard = None, force = false))]
+fn sweep_prepare(
+    out: PathBuf,
+    spec: &str,
+    shard: Option<&str>,
+    force: bool,
+) -> PyResult<Vec<usize>> {
+    let (file, _) = sweep::expand(&parse_sweep(spec)?, parse_shard(shard)?).map_err(invalid)?;
+    folder::check_out_dir(&out, force, &[sweep::SWEEP_FILE, sweep::RUNS_DIR]).map_err(invalid)?;
+    std::fs::create_dir_all(&out)
+        .map_err(|e| failed(format!("cannot create {}: {e}", out.display())))?;
+    folder::write_atomic(
+        &out.join(sweep::SWEEP_FILE),
+        folder::to_json_line(&file).map_err(failed)?.as_bytes(),
+    )
+    .map_err(failed)?;
+    Ok(file.shard_runs().map(|r| r.index).collect())
+}
+
+/// Runs (or resumes, or leaves as is when complete) run `index` of the sweep folder `out`,
+/// re-expanding its `sweep.json`: one deterministic unit of a sweep, as `sepg sweep` runs
+/// it. Returns the run folder.
+#[pyfunction]
+#[pyo3(signature = (out, index, checkpoint_every = 2000))]
+fn sweep_run(
+    py: Python<'_>,
+    out: PathBuf,
+    index: usize,
+    checkpoint_every: u64,
+) -> PyResult<PathBuf> {
+    let file = SweepFile::read(&out).map_err(invalid)?;
+    let (expected, resolved) = sweep::expand(&file.spec, file.shard).map_err(invalid)?;
+    if expected.sweep_id != file.sweep_id {
+        return Err(invalid(format!(
+            "{} was written by another sepg version (sweep id differs)",
+            out.display()
+        )));
+    }
+    let entry = file
+        .shard_runs()
+        .find(|r| r.index == index)
+        .ok_or_else(|| {
+            invalid(format!(
+                "run {index} is not in the shard of {}",
+                out.display()
+            ))
+        })?;
+    let dir = out.join(&entry.dir);
+    if folder::is_complete(&dir) {
+        return Ok(dir);
+    }
+    let watch = SignalWatch::new();
+    let opts = RunOptions {
+        checkpoint_every: checkpoint_period(checkpoint_every)?,
+        stop: &watch.stop,
+        observer: &watch,
+    };
+    let done = py.detach(|| {
+        if dir.join(folder::CONFIG_FILE).is_file() {
+            run::resume(&dir, opts)
+        } else {
+            run::start(&dir, &resolved[index], opts)
+        }
+    });
+    done.map_err(|e| watch.error(e))?;
+    Ok(dir)
+}
+
+/// Merges the complete shard folders `shards` of one sweep into `out`; returns the merged
+/// `sweep.json` as text.
+#[pyfunction]
+#[pyo3(signature = (shards, out, force = false))]
+fn merge_folders(shards: Vec<PathBuf>, out: PathBuf, force: bool) -> PyResult<String> {
+    let file = sepg_runs::merge::merge(&shards, &out, force).map_err(|e| {
+        if e.is_invalid_input() {
+            invalid(e)
+        } else {
+            failed(e)
+        }
+    })?;
+    json(&file)
+}
+
+/// Re-checks the log of the run folder `dir` against its safety requirement (with the exact
+/// oracle where one exists) and returns the report as JSON text: every violation with its
+/// iteration, check, required and actual values.
+#[pyfunction]
+#[pyo3(signature = (dir, tolerance = 1e-9))]
+fn audit_folder(dir: PathBuf, tolerance: f64) -> PyResult<String> {
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(invalid(format!(
+            "tolerance = {tolerance} must be finite and non-negative"
+        )));
+    }
+    let report = sepg_runs::audit::audit(&dir, tolerance).map_err(|e| {
+        if e.is_invalid_input() {
+            invalid(e)
+        } else {
+            failed(e)
+        }
+    })?;
+    json(&report)
+}
+
+/// The sweep file (TOML) at `path` as JSON text, for [`sweep_folder`] and [`sweep_prepare`].
+#[pyfunction]
+fn read_sweep_file(path: PathBuf) -> PyResult<String> {
+    json(&sweep::read_spec(&path).map_err(invalid)?)
+}
+
+/// Adds the functions of this module to `m`.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(resume_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(read_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_prepare, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_run, m)?)?;
+    m.add_function(wrap_pyfunction!(merge_folders, m)?)?;
+    m.add_function(wrap_pyfunction!(audit_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(read_sweep_file, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,357 @@
+//! SEPG and the comparison algorithms on trajectories collected in Python: a [`Trainer`]
+//! owns a `sepg_algo` solver whose every batch comes from a Python callable (the collector),
+//! so the estimation, the safe steps and the budget bookkeeping are those of the Rust
+//! algorithms, bit for bit. The gymnasium driver of `sepg.gym` is such a collector.
+use std::sync::{Arc, Mutex};
+
+use numpy::PyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyModule;
+use sepg_algo::core::config::{Algorithm, Requirement};
+use sepg_algo::core::error::RunError;
+use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::core::seed::Block;
+use sepg_algo::core::state::State;
+use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
+use sepg_algo::solver::{CollectedConfig, PolicySolver};
+use sepg_estimators::GradientSpec;
+use sepg_mdp::rng::Stream;
+use sepg_mdp::{Batch, GaussianPolicy};
+
+use crate::safe::lengths_of;
+use crate::{PyTaskConstants, failed, floats, invalid};
+
+/// The algorithm named as on the command line: `sepg-mi`, `sepg-lb1`, `sepg-lb2`, `sepg-lv`,
+/// `sepg-zv`, `sepg-sim`, `sepg-naive-w` (with `requirement`), `gpomdp-const` (with `alpha`,
+/// `beta`), `gpomdp-adam` (with `lr`, `lr_w`) or `adastep`; ν is the split of LB-I and SIM.
+pub(crate) fn algorithm(
+    name: &str,
+    nu: f64,
+    requirement: &str,
+    alpha: Option<f64>,
+    beta: Option<f64>,
+    lr: Option<f64>,
+    lr_w: Option<f64>,
+) -> PyResult<Algorithm> {
+    let req = |r: &str| -> PyResult<Requirement> {
+        Ok(match r {
+            "mi" => Requirement::Mi,
+            "lb1" => Requirement::LbI { nu },
+            "lb2" => Requirement::LbII,
+            "lv" => Requirement::Lv,
+            "zv" => Requirement::Zv,
+            "sim" => Requirement::Sim { nu },
+            other => {
+                return Err(invalid(format!(
+                    "unknown requirement {other:?}: expected mi, lb1, lb2, lv, zv or sim"
+                )));
+            }
+        })
+    };
+    let need = |v: Option<f64>, what: &str| {
+        v.ok_or_else(|| invalid(format!("algorithm {name} needs {what}")))
+    };
+    Ok(match name {
+        "sepg-naive-w" => Algorithm::SepgNaiveW(req(requirement)?),
+        "gpomdp-const" => {
+            let a = need(alpha, "alpha")?;
+            Algorithm::GpomdpConst {
+                alpha: a,
+                beta: beta.unwrap_or(a),
+            }
+        }
+        "gpomdp-adam" => {
+            let l = need(lr, "lr")?;
+            Algorithm::adam(l, lr_w.unwrap_or(l))
+        }
+        "adastep" => Algorithm::AdaStep,
+        other => match other.strip_prefix("sepg-") {
+            Some(r) if r != "naive-w" => Algorithm::Sepg(req(r).map_err(|_| {
+                invalid(format!(
+                    "unknown algorithm {other:?}: expected sepg-mi, sepg-lb1, sepg-lb2, sepg-lv, sepg-zv, sepg-sim, sepg-naive-w, gpomdp-const, gpomdp-adam or adastep"
+                ))
+            })?),
+            _ => {
+                return Err(invalid(format!(
+                    "unknown algorithm {other:?}: expected sepg-mi, sepg-lb1, sepg-lb2, sepg-lv, sepg-zv, sepg-sim, sepg-naive-w, gpomdp-const, gpomdp-adam or adastep"
+                )));
+            }
+        },
+    })
+}
+
+/// What the collector is asked for: `n` trajectories of the policy
+/// a ~ N(V φ(s), diag σ²) (deterministic a = V φ(s) when `w` is `None`), trajectory `i`
+/// seeded with `env_seeds[i]` (for `env.reset(seed=...)`) and `policy_seeds[i]` (for the
+/// action noise). `scores` says whether the actions and features are needed (else only
+/// the rewards and lengths are used).
+#[pyclass(frozen, name = "BatchRequest", module = "sepg")]
+#[derive(Debug, Clone)]
+pub struct PyBatchRequest {
+    /// Iteration of the algorithm.
+    #[pyo3(get)]
+    iteration: u64,
+    /// `"v"`, `"target"` or `"w"` (the blocks of Algorithm 4.3).
+    #[pyo3(get)]
+    block: &'static str,
+    /// Number of trajectories.
+    #[pyo3(get)]
+    n: usize,
+    /// Whether actions and features are needed.
+    #[pyo3(get)]
+    scores: bool,
+    /// Per-trajectory environment seeds.
+    #[pyo3(get)]
+    env_seeds: Vec<u64>,
+    /// Per-trajectory policy seeds.
+    #[pyo3(get)]
+    policy_seeds: Vec<u64>,
+    v: Vec<f64>,
+    w: Option<Vec<f64>>,
+    actions: usize,
+}
+
+#[pymethods]
+impl PyBatchRequest {
+    /// The mean matrix V, shape `(actions, features)`: μ(s) = V φ(s).
+    #[getter]
+    fn mean<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let p = self.v.len() / self.actions;
+        let rows: Vec<Vec<f64>> = self.v.chunks_exact(p).map(<[f64]>::to_vec).collect();
+        PyArray2::from_vec2(py, &rows).map_err(failed)
+    }
+
+    /// The standard deviations σ = e^w, `None` for the deterministic policy.
+    #[getter]
+    fn sigma(&self) -> Option<Vec<f64>> {
+        self.w.as_ref().map(|w| w.iter().map(|x| x.exp()).collect())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "BatchRequest(iteration={}, block={:?}, n={}, scores={})",
+            self.iteration, self.block, self.n, self.scores
+        )
+    }
+}
+
+/// The collector side of a [`Trainer`]: calls the Python callable and turns its arrays into
+/// a [`Batch`]. A Python exception is kept to be re-raised as it is.
+struct PyCollector {
+    callable: Py<PyAny>,
+    gamma: f64,
+    features: usize,
+    error: Arc<Mutex<Option<PyErr>>>,
+}
+
+impl PyCollector {
+    fn collect_py(&self, py: Python<'_>, r: &BatchRequest<'_>) -> PyResult<Batch> {
+        let seeds = |stream| (0..r.n as u64).map(move |i| r.key.trajectory_seed(i, stream));
+        let request = PyBatchRequest {
+            iteration: r.iteration,
+            block: match r.block {
+                Block::V => "v",
+                Block::Target => "target",
+                Block::W => "w",
+            },
+            n: r.n,
+            scores: r.scores,
+            env_seeds: seeds(Stream::Environment).collect(),
+            policy_seeds: seeds(Stream::Policy).collect(),
+            v: r.v.to_vec(),
+            w: r.w.map(<[f64]>::to_vec),
+            actions: r.v.len() / self.features,
+        };
+        let out = self.callable.bind(py).call1((request,))?;
+        let parts: (
+            Bound<'_, PyAny>,
+            Bound<'_, PyAny>,
+            Bound<'_, PyAny>,
+            Bound<'_, PyAny>,
+        ) = out.extract().map_err(|_| {
+            invalid("the collector must return (rewards, actions, features, lengths)")
+        })?;
+        let (rewards, actions, features, lengths) = parts;
+        let (rw, rshape) = floats(&rewards, "rewards", Some(2))?;
+        if rshape[0] != r.n {
+            return Err(invalid(format!(
+                "rewards must have {} rows (one per trajectory), got shape {rshape:?}",
+                r.n
+            )));
+        }
+        let (n, h) = (rshape[0], rshape[1]);
+        let lens = lengths_of(&lengths, n)?;
+        let (Some(w), true) = (r.w, r.scores) else {
+            return Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid);
+        };
+        let policy =
+            GaussianPolicy::new(r.v.to_vec(), w.to_vec(), self.features).map_err(invalid)?;
+        let (a, ashape) = floats(&actions, "actions", Some(3))?;
+        let (phi, fshape) = floats(&features, "features", Some(3))?;
+        let (l, p) = (policy.action_dim(), self.features);
+        if ashape != [n, h, l] || fshape != [n, h, p] {
+            return Err(invalid(format!(
+                "actions must have shape ({n}, {h}, {l}) and features ({n}, {h}, {p}); got {ashape:?} and {fshape:?}"
+            )));
+        }
+        let (mut sv, mut sw) = (vec![0.0; n * h * l * p], vec![0.0; n * h * l]);
+        for (i, &len) in lens.iter().enumerate() {
+            for t in 0..len.min(h) {
+                let c = i * h + t;
+                let (phi, a) = (&phi[c * p..(c + 1) * p], &a[c * l..(c + 1) * l]);
+                policy
+                    .score_v(phi, a, &mut sv[c * l * p..(c + 1) * l * p])
+                    .map_err(invalid)?;
+                policy
+                    .score_w(phi, a, &mut sw[c * l..(c + 1) * l])
+                    .map_err(invalid)?;
+            }
+        }
+        let sigma: Vec<f64> = w.iter().map(|x| x.exp()).collect();
+        Batch::from_steps(h, self.gamma, &sigma, &rw, &sv, &sw, &lens).map_err(invalid)
+    }
+}
+
+impl BatchCollector for PyCollector {
+    fn collect(&mut self, request: &BatchRequest<'_>) -> Result<Batch, RunError> {
+        Python::attach(|py| {
+            self.collect_py(py, request).map_err(|e| {
+                let message = e.to_string();
+                if let Ok(mut slot) = self.error.lock() {
+                    *slot = Some(e);
+                }
+                RunError::Mdp(format!("the collector failed: {message}"))
+            })
+        })
+    }
+}
+
+/// SEPG (Algorithm 4.3, every requirement of Table 4.1) or a comparison algorithm of
+/// Chapter 5 on trajectories collected by a Python callable. `collector(request)` receives a
+/// [`PyBatchRequest`] and returns `(rewards (N, H), actions (N, H, l), features (N, H, p),
+/// lengths (N,))` with the raw sampled actions; the scores, estimates, widths, safe steps and
+/// budget are computed in Rust. Records are returned as JSON text (one object per iteration,
+/// the fields of the run log).
+#[pyclass(unsendable, name = "Trainer", module = "sepg")]
+pub struct Trainer {
+    parts: Option<(PolicySolver, State)>,
+    error: Arc<Mutex<Option<PyErr>>>,
+}
+
+#[pymethods]
+impl Trainer {
+    /// A trainer for `algorithm` (named as on the command line) with validated `constants`,
+    /// `actions` action dimensions and `features` features; v⁰ (default −0.1 everywhere,
+    /// action-major `v[j·p + i]`), σ⁰ (default 1), N trajectories per iteration, seed, δ,
+    /// initial budget B⁰ ≥ 0.
+    #[new]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        algorithm: &str,
+        constants: PyRef<'_, PyTaskConstants>,
+        actions: usize,
+        features: usize,
+        collector: Py<PyAny>,
+        n_trajectories: usize,
+        seed: u64,
+        delta: f64,
+        v0: Option<&Bound<'_, PyAny>>,
+        sigma0: Option<&Bound<'_, PyAny>>,
+        initial_budget: f64,
+        nu: f64,
+        requirement: &str,
+        alpha: Option<f64>,
+        beta: Option<f64>,
+        lr: Option<f64>,
+        lr_w: Option<f64>,
+    ) -> PyResult<Self> {
+        let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
+        let dim_v = actions
+            .checked_mul(features)
+            .ok_or_else(|| invalid("actions × features overflows"))?;
+        let v0 = match v0 {
+            Some(v) => floats(v, "v0", None)?.0,
+            None => vec![-0.1; dim_v],
+        };
+        let sigma0 = match sigma0 {
+            Some(s) => floats(s, "sigma0", None)?.0,
+            None => vec![1.0; actions],
+        };
+        if v0.len() != dim_v || sigma0.len() != actions {
+            return Err(invalid(format!(
+                "v0 must have {dim_v} entries (actions × features) and sigma0 {actions}; got {} and {}",
+                v0.len(),
+                sigma0.len()
+            )));
+        }
+        if let Some(s) = sigma0.iter().find(|s| !(**s > 0.0 && s.ln().is_finite())) {
+            return Err(invalid(format!(
+                "sigma0 must be positive and finite, got {s}"
+            )));
+        }
+        if !(initial_budget.is_finite() && initial_budget >= 0.0) {
+            return Err(invalid(format!(
+                "initial_budget = {initial_budget} must be finite and non-negative"
+            )));
+        }
+        let config = CollectedConfig {
+            algorithm,
+            constants: constants.0,
+            delta,
+            estimator: GradientSpec::default(),
+            n_trajectories,
+            seed,
+            actions,
+            features,
+        };
+        let error = Arc::new(Mutex::new(None));
+        let collector = PyCollector {
+            callable: collector,
+            gamma: constants.0.gamma(),
+            features,
+            error: Arc::clone(&error),
+        };
+        let solver = PolicySolver::with_collector(&config, Box::new(collector)).map_err(invalid)?;
+        let state = State::new(v0, sigma0.iter().map(|s| s.ln()).collect(), initial_budget);
+        Ok(Trainer {
+            parts: Some((solver, state)),
+            error,
+        })
+    }
+
+    /// Runs `iterations` more iterations and returns their records as JSON text. On error
+    /// the state stays after the last completed iteration; an exception of the collector is
+    /// re-raised as it is.
+    fn run(&mut self, iterations: u64) -> PyResult<String> {
+        let (solver, state) = self
+            .parts
+            .take()
+            .ok_or_else(|| failed("the trainer is unusable after an internal error"))?;
+        let mut log = Collect::default();
+        let mut exec = Executor::new(solver, state).observe(&mut log);
+        let result = exec.run(iterations);
+        self.parts = Some(exec.into_parts());
+        if let Err(e) = result {
+            let stored = self.error.lock().ok().and_then(|mut s| s.take());
+            return Err(stored.unwrap_or_else(|| failed(e)));
+        }
+        serde_json::to_string(&log.records).map_err(failed)
+    }
+
+    /// The state after the last completed iteration (the checkpoint), as JSON text.
+    fn state(&self) -> PyResult<String> {
+        let (_, state) = self
+            .parts
+            .as_ref()
+            .ok_or_else(|| failed("the trainer is unusable after an internal error"))?;
+        serde_json::to_string(state).map_err(failed)
+    }
+}
+
+/// Adds the classes of this module to `m`.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyBatchRequest>()?;
+    m.add_class::<Trainer>()?;
+    Ok(())
+}

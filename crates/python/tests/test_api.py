@@ -1,0 +1,31 @@
+"""The public surface: every native function is reachable, documented and stubbed."""
+
+import ast
+import pathlib
+
+import sepg
+from sepg import _native, bounds
+
+STUB = pathlib.Path(sepg.__file__).with_name("_native.pyi")
+
+
+def test_every_native_item_has_a_docstring_and_a_stub():
+    stubbed = {
+        node.name
+        for node in ast.parse(STUB.read_text()).body
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+    }
+    public = {name for name in dir(_native) if not name.startswith("_")}
+    assert public == stubbed
+    for name in public:
+        assert (getattr(_native, name).__doc__ or "").strip(), name
+
+
+def test_bounds_exports_every_bound_function():
+    prefixes = ("constants_", "pirotta_", "papini_", "batch_size_", "v_update_", "w_update_",
+                "surrogate_", "high_probability_", "greedy_", "rigorous_", "budget_")
+    native = {n for n in dir(_native) if n.startswith(prefixes)}
+    assert native <= set(bounds.__all__)
+    assert len(native) == 43
+    for name in sepg.__all__:
+        assert hasattr(sepg, name), name
