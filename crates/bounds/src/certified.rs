@@ -450,6 +450,9 @@ impl RigorousEnclosure {
 
 /// Encloses KL2(t) = e^{−2t} − 1 + 2t at an exact t ≥ 0 (see [`rigorous::kl2`]).
 fn kl2_at(t: f64) -> Interval {
+    if t == 0.0 {
+        return Interval::point(0.0);
+    }
     let y = Interval::point(t).scale(2.0);
     if y.hi() < 0.1 {
         // Σ_{n≥2} (−y)^n / n!: alternating with decreasing terms, so the tail after n = 17 lies

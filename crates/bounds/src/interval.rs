@@ -235,7 +235,11 @@ impl Interval {
     /// ```
     #[inline]
     pub fn scale(self, x: f64) -> Self {
-        if x >= 0.0 {
+        if x == 0.0 {
+            // an enclosed real times exactly zero is exactly zero
+            return Self::point(0.0);
+        }
+        if x > 0.0 {
             Self::rounded(self.lo * x, self.hi * x)
         } else {
             Self::rounded(self.hi * x, self.lo * x)
@@ -278,6 +282,12 @@ impl Add for Interval {
     type Output = Interval;
     #[inline]
     fn add(self, rhs: Interval) -> Interval {
+        if rhs == Interval::point(0.0) {
+            return self;
+        }
+        if self == Interval::point(0.0) {
+            return rhs;
+        }
         Interval::rounded(self.lo + rhs.lo, self.hi + rhs.hi)
     }
 }
@@ -286,6 +296,12 @@ impl Sub for Interval {
     type Output = Interval;
     #[inline]
     fn sub(self, rhs: Interval) -> Interval {
+        if rhs == Interval::point(0.0) {
+            return self;
+        }
+        if self == Interval::point(0.0) {
+            return -rhs;
+        }
         Interval::rounded(self.lo - rhs.hi, self.hi - rhs.lo)
     }
 }
@@ -294,6 +310,9 @@ impl Mul for Interval {
     type Output = Interval;
     #[inline]
     fn mul(self, rhs: Interval) -> Interval {
+        if self == Interval::point(0.0) || rhs == Interval::point(0.0) {
+            return Interval::point(0.0);
+        }
         if self.lo >= 0.0 && rhs.lo >= 0.0 {
             // both non-negative: the common case of every penalty coefficient
             return Interval::rounded(self.lo * rhs.lo, self.hi * rhs.hi);
