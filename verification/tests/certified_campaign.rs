@@ -58,7 +58,10 @@ fn campaign_small() {
     // and certification had to move steps to avoid that
     let violated: u64 = tallies.iter().map(|t| t.uncertified_violations).sum();
     let moved: u64 = tallies.iter().map(|t| t.moved).sum();
-    assert!(violated > 100 && moved > 100, "violated {violated}, moved {moved}");
+    assert!(
+        violated > 100 && moved > 100,
+        "violated {violated}, moved {moved}"
+    );
 }
 
 #[test]

@@ -86,7 +86,8 @@ pub fn c(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     positive("sigma", sigma)?;
     let om = one_minus_gamma(k);
     let s = Interval::point(sigma);
-    let front = Interval::point(k.r_max()) * Interval::point(k.m_phi()).sqr() / (om.sqr() * s.sqr());
+    let front =
+        Interval::point(k.r_max()) * Interval::point(k.m_phi()).sqr() / (om.sqr() * s.sqr());
     let bracket = Interval::point(k.action_volume()) / (sqrt_2pi() * s)
         + Interval::point(k.gamma()) / (om + om);
     Ok(front * bracket)
@@ -589,7 +590,7 @@ pub fn certify<B: EnclosedBound + ?Sized>(
     required: f64,
 ) -> Certified {
     match outcome {
-        StepOutcome::Feasible(s) => match search(bound, s.hi, s.vertex, required) {
+        StepOutcome::Feasible(s) => match certify_toward(bound, s.hi, s.vertex, required) {
             Ok((step, enclosure, ulps_moved)) => Certified::Step(CertifiedStep {
                 step,
                 bound: enclosure,
@@ -614,7 +615,21 @@ pub fn certify<B: EnclosedBound + ?Sized>(
 
 /// The first `f64` from `from` toward `toward` (both included) whose enclosure has lower end
 /// ≥ `required`: (step, enclosure, ulps moved), or the enclosure at `toward` if none passes.
-fn search<B: EnclosedBound + ?Sized>(
+///
+/// [`certify`] uses it from the largest safe step toward the vertex; use it directly to
+/// certify another end point of a safe interval (e.g. the smallest step), moving toward the
+/// vertex too. The search doubles the number of ulps until a step passes, then bisects.
+///
+/// ```
+/// use sepg_bounds::{certified::{certify_toward, Quadratic}, constants::TaskConstants, outcome::StepOutcome, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let StepOutcome::Feasible(s) = w_update::safe_step_along_j(&k, 1.0, 0.3, -0.01)? else { panic!() };
+/// let q = Quadratic::w_along_j(&k, 1.0, 0.3)?;
+/// let (step, bound, _) = certify_toward(&q, s.lo, s.vertex, -0.01).unwrap();
+/// assert!(bound.lo() >= -0.01 && step >= s.lo);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn certify_toward<B: EnclosedBound + ?Sized>(
     bound: &B,
     from: f64,
     toward: f64,
@@ -743,11 +758,7 @@ pub fn w_safe_step_along_l(
 }
 
 /// Certifies a high-probability outcome, or passes `BelowNoise` through.
-fn certify_hp(
-    enclosure: Option<HpEnclosure>,
-    outcome: StepOutcome,
-    required: f64,
-) -> Certified {
+fn certify_hp(enclosure: Option<HpEnclosure>, outcome: StepOutcome, required: f64) -> Certified {
     match enclosure {
         Some(e) => certify(&e, outcome, required),
         None => Certified::BelowNoise,

@@ -458,7 +458,11 @@ fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
             )
         }
     };
-    result.1.c_max().is_none_or(f64::is_finite).then_some(result)
+    result
+        .1
+        .c_max()
+        .is_none_or(f64::is_finite)
+        .then_some(result)
 }
 
 /// The exact bound of form `form` at the step x.
@@ -473,11 +477,7 @@ fn exact_bound(form: usize, c: &Case, ex: &Exact, x: f64) -> Option<Mp> {
             let g2 = Mp::f(j).sqr();
             parabola(x, &g2, &ex.d()?.mul(&g2))
         }
-        2 => parabola(
-            x,
-            &Mp::f(l).mul(&Mp::f(j)),
-            &ex.d()?.mul(&Mp::f(l).sqr()),
-        ),
+        2 => parabola(x, &Mp::f(l).mul(&Mp::f(j)), &ex.d()?.mul(&Mp::f(l).sqr())),
         3 | 4 => {
             let (lo, hi) = corrected(inf_norm(&c.grad_v), c.eps_v);
             let upper = hi.sqr();

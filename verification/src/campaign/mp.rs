@@ -210,7 +210,10 @@ impl Mp {
 
     /// The exact point d.
     pub(crate) fn point(d: Dyadic) -> Self {
-        Self { lo: d.clone(), hi: d }
+        Self {
+            lo: d.clone(),
+            hi: d,
+        }
     }
 
     /// The exact integer i.
@@ -398,7 +401,11 @@ pub(crate) fn kl2(t: &Dyadic) -> Mp {
         let mut term = y.sqr().ldexp(-1);
         let mut sum = term.clone();
         for n in 3..=50 {
-            term = term.mul(&y).neg().div(&Mp::int(n)).unwrap_or_else(|| Mp::int(0));
+            term = term
+                .mul(&y)
+                .neg()
+                .div(&Mp::int(n))
+                .unwrap_or_else(|| Mp::int(0));
             sum = sum.add(&term);
         }
         let tail = term.mul(&y).div(&Mp::int(51)).unwrap_or_else(|| Mp::int(0));
@@ -432,7 +439,10 @@ fn atan_inv(q: i64) -> Mp {
             sum.add(&term)
         };
     }
-    let tail = power.mul(&x2).div(&Mp::int(401)).unwrap_or_else(|| Mp::int(0));
+    let tail = power
+        .mul(&x2)
+        .div(&Mp::int(401))
+        .unwrap_or_else(|| Mp::int(0));
     sum.add(&Mp::symmetric(&max(tail.lo.abs(), tail.hi.abs())))
 }
 
@@ -453,7 +463,11 @@ pub(crate) fn psi() -> &'static Mp {
     static P: OnceLock<Mp> = OnceLock::new();
     P.get_or_init(|| {
         let s7 = Mp::int(7).sqrt();
-        let e = s7.ldexp(-1).sub(&Mp::int(2)).exp().unwrap_or_else(|| Mp::int(0));
+        let e = s7
+            .ldexp(-1)
+            .sub(&Mp::int(2))
+            .exp()
+            .unwrap_or_else(|| Mp::int(0));
         s7.sub(&Mp::int(2))
             .ldexp(2)
             .mul(&e)
@@ -479,7 +493,10 @@ mod tests {
         ));
         // exp(−x)·exp(x) encloses 1 for a large argument
         let big = Mp::f(37.25);
-        let one = big.exp().expect("small").mul(&big.neg().exp().expect("small"));
+        let one = big
+            .exp()
+            .expect("small")
+            .mul(&big.neg().exp().expect("small"));
         assert!(one.sub(&Mp::int(1)).inside(-1e-60, 1e-60));
         let s = Mp::int(2).sqrt();
         assert!(s.sqr().sub(&Mp::int(2)).inside(-1e-70, 1e-70));
