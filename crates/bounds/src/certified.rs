@@ -126,6 +126,12 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
 pub trait EnclosedBound {
     /// An interval that contains the exact value B(x).
     fn enclose(&self, x: f64) -> Interval;
+
+    /// An approximation of B'(x), used only to guess how far a failing step must move
+    /// (any value, or `None`, keeps [`certify`] correct; a good one makes it faster).
+    fn slope(&self, _x: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// The concave parabola B(x) = a·x − b·x² (b ≥ 0) shared by Theorems 4.2, 4.3, 4.5, 4.7–4.9,
@@ -274,6 +280,10 @@ impl EnclosedBound for Quadratic {
     fn enclose(&self, x: f64) -> Interval {
         (self.linear - self.quadratic.scale(x)).scale(x)
     }
+
+    fn slope(&self, x: f64) -> Option<f64> {
+        Some(self.linear.lo() - 2.0 * self.quadratic.lo() * x)
+    }
 }
 
 /// The high-probability bounds of Theorems 4.7–4.9 with enclosed coefficients, in either
@@ -400,6 +410,10 @@ impl EnclosedBound for HpEnclosure {
     #[inline]
     fn enclose(&self, x: f64) -> Interval {
         self.side(x).enclose(x)
+    }
+
+    fn slope(&self, x: f64) -> Option<f64> {
+        self.side(x).slope(x)
     }
 }
 
@@ -654,18 +668,44 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
         })
     };
     let mut failed = 0_u64;
-    let mut distance = 1_u64;
-    let (mut good, mut good_enclosure) = loop {
-        let offset = distance.min(total);
-        let e = bound.enclose(at(offset));
-        if e.lo() >= required {
-            break (offset, e);
+    // first trial: the move that the bound's slope predicts for the shortfall plus the
+    // enclosure's width (usually exact, so the bisection below only confirms it)
+    let mut distance = bound
+        .slope(from)
+        .map(|slope| {
+            let ulp = (at(1) - from).abs();
+            let needed = (required - first.lo() + first.width()) / (slope.abs() * ulp);
+            if needed.is_finite() && needed >= 1.0 {
+                needed.ceil().min(total as f64) as u64
+            } else {
+                1
+            }
+        })
+        .unwrap_or(1);
+    let mut found = None;
+    if distance > 1 {
+        let e = bound.enclose(at(distance - 1));
+        if e.lo() < required {
+            failed = distance - 1;
+        } else {
+            found = Some((distance - 1, e));
         }
-        if offset == total {
-            return Err(e);
+    }
+    let (mut good, mut good_enclosure) = if let Some(f) = found {
+        f
+    } else {
+        loop {
+            let offset = distance.min(total);
+            let e = bound.enclose(at(offset));
+            if e.lo() >= required {
+                break (offset, e);
+            }
+            if offset == total {
+                return Err(e);
+            }
+            failed = offset;
+            distance = distance.saturating_mul(2);
         }
-        failed = offset;
-        distance = distance.saturating_mul(2);
     };
     while good - failed > 1 {
         let mid = failed + (good - failed) / 2;
