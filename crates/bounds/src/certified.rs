@@ -31,6 +31,9 @@ use crate::interval::{Interval, from_ordered_key, ordered_key};
 use crate::outcome::{SafeInterval, StepOutcome};
 use crate::{rigorous, v_update, w_update};
 
+/// Ulps walked one at a time around the predicted move before bisecting or doubling.
+const LOCAL_STEPS: u64 = 4;
+
 /// √(2π) ∈ [2.5066282746310002, 2.5066282746310007] (the two `f64` around it).
 const SQRT_2PI_LO: f64 = 2.506_628_274_631_000_2;
 const SQRT_2PI_HI: f64 = 2.506_628_274_631_000_7;
@@ -487,6 +490,10 @@ fn kl2_at(t: f64) -> Interval {
 
 impl EnclosedBound for RigorousEnclosure {
     fn enclose(&self, beta: f64) -> Interval {
+        if beta == 0.0 {
+            // f(0) = 0 exactly
+            return Interval::point(0.0);
+        }
         let dw = Interval::point(beta).scale(self.direction);
         let curvature = Interval::point(1.0).max((-dw).exp());
         let (m_lo, m_hi) = if dw.lo() >= 0.0 {
@@ -667,53 +674,59 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
             start + offset
         })
     };
-    let mut failed = 0_u64;
-    // first trial: the move that the bound's slope predicts for the shortfall plus the
-    // enclosure's width (usually exact, so the bisection below only confirms it)
-    let mut distance = bound
+    let passes = |offset: u64| {
+        let e = bound.enclose(at(offset));
+        (e.lo() >= required, e)
+    };
+    // Bracket the first passing offset: `failed` fails, `good` passes. Start from the move
+    // that the bound's slope predicts for the shortfall (usually within an ulp or two of the
+    // answer), walking one ulp at a time near it; fall back to doubling.
+    let guess = bound
         .slope(from)
-        .map(|slope| {
-            let ulp = (at(1) - from).abs();
-            let needed = (required - first.lo() + first.width()) / (slope.abs() * ulp);
-            if needed.is_finite() && needed >= 1.0 {
-                needed.ceil().min(total as f64) as u64
-            } else {
-                1
+        .map(|slope| (required - first.lo()) / (slope.abs() * (at(1) - from).abs()))
+        .filter(|g| g.is_finite() && *g >= 1.0)
+        .map_or(1, |g| (g.ceil() as u64).min(total));
+    let (mut failed, mut good, mut good_enclosure) = match passes(guess) {
+        (true, e) => {
+            let (mut good, mut good_enclosure) = (guess, e);
+            for _ in 0..LOCAL_STEPS {
+                if good == 1 {
+                    break;
+                }
+                match passes(good - 1) {
+                    (true, e) => (good, good_enclosure) = (good - 1, e),
+                    (false, _) => return Ok((at(good), good_enclosure, good)),
+                }
             }
-        })
-        .unwrap_or(1);
-    let mut found = None;
-    if distance > 1 {
-        let e = bound.enclose(at(distance - 1));
-        if e.lo() < required {
-            failed = distance - 1;
-        } else {
-            found = Some((distance - 1, e));
+            (0, good, good_enclosure)
         }
-    }
-    let (mut good, mut good_enclosure) = if let Some(f) = found {
-        f
-    } else {
-        loop {
-            let offset = distance.min(total);
-            let e = bound.enclose(at(offset));
-            if e.lo() >= required {
-                break (offset, e);
+        (false, e) => {
+            let mut failed = guess;
+            let mut last = e;
+            let mut distance = 1_u64;
+            loop {
+                if failed == total {
+                    return Err(last);
+                }
+                let offset = failed.saturating_add(distance).min(total);
+                let (ok, e) = passes(offset);
+                if ok {
+                    break (failed, offset, e);
+                }
+                (failed, last) = (offset, e);
+                if distance < LOCAL_STEPS {
+                    distance += 1;
+                } else {
+                    distance = distance.saturating_mul(2);
+                }
             }
-            if offset == total {
-                return Err(e);
-            }
-            failed = offset;
-            distance = distance.saturating_mul(2);
         }
     };
     while good - failed > 1 {
         let mid = failed + (good - failed) / 2;
-        let e = bound.enclose(at(mid));
-        if e.lo() >= required {
-            (good, good_enclosure) = (mid, e);
-        } else {
-            failed = mid;
+        match passes(mid) {
+            (true, e) => (good, good_enclosure) = (mid, e),
+            (false, _) => failed = mid,
         }
     }
     Ok((at(good), good_enclosure, good))

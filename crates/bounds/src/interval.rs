@@ -154,7 +154,9 @@ impl Interval {
     pub fn sqr(self) -> Self {
         let (a, b) = (self.lo.abs(), self.hi.abs());
         let (small, large) = if a <= b { (a, b) } else { (b, a) };
-        if self.lo <= 0.0 && self.hi >= 0.0 {
+        if large == 0.0 {
+            Self::point(0.0)
+        } else if self.lo <= 0.0 && self.hi >= 0.0 {
             Self {
                 lo: 0.0,
                 hi: up(large * large),
@@ -282,12 +284,6 @@ impl Add for Interval {
     type Output = Interval;
     #[inline]
     fn add(self, rhs: Interval) -> Interval {
-        if rhs == Interval::point(0.0) {
-            return self;
-        }
-        if self == Interval::point(0.0) {
-            return rhs;
-        }
         Interval::rounded(self.lo + rhs.lo, self.hi + rhs.hi)
     }
 }
@@ -296,12 +292,6 @@ impl Sub for Interval {
     type Output = Interval;
     #[inline]
     fn sub(self, rhs: Interval) -> Interval {
-        if rhs == Interval::point(0.0) {
-            return self;
-        }
-        if self == Interval::point(0.0) {
-            return -rhs;
-        }
         Interval::rounded(self.lo - rhs.hi, self.hi - rhs.lo)
     }
 }
@@ -310,9 +300,6 @@ impl Mul for Interval {
     type Output = Interval;
     #[inline]
     fn mul(self, rhs: Interval) -> Interval {
-        if self == Interval::point(0.0) || rhs == Interval::point(0.0) {
-            return Interval::point(0.0);
-        }
         if self.lo >= 0.0 && rhs.lo >= 0.0 {
             // both non-negative: the common case of every penalty coefficient
             return Interval::rounded(self.lo * rhs.lo, self.hi * rhs.hi);
