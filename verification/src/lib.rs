@@ -18,6 +18,7 @@
 //! ```
 
 pub mod bound_fns;
+pub mod campaign;
 mod check;
 mod checks;
 pub mod finite_mdp;

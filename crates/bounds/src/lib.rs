@@ -17,6 +17,8 @@
 //! | [`greedy`] | Section 4.3.4 (multi-dimensional greedy-coordinate updates) |
 //! | [`rigorous`] | Theorem 4.3 without neglected terms (Lemmas A.1–A.3) |
 //! | [`budget`] | Definition 4.3, Theorem 4.1, eqs. (4.13)–(4.14) |
+//! | [`interval`] | outward-rounded interval arithmetic |
+//! | [`certified`] | certified safe steps: the bounds above evaluated in interval arithmetic |
 //!
 //! ```
 //! use sepg_bounds::{constants::TaskConstants, outcome::StepOutcome, v_update};
@@ -29,10 +31,12 @@
 
 pub mod batch_size;
 pub mod budget;
+pub mod certified;
 pub mod constants;
 pub mod error;
 pub mod greedy;
 pub mod high_probability;
+pub mod interval;
 pub mod outcome;
 pub mod papini;
 pub mod pirotta;

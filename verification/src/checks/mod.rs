@@ -2,6 +2,7 @@
 
 mod algorithm;
 mod appendix_a;
+mod certified;
 mod chapter3;
 mod chapter4;
 mod lqg_exact;
@@ -27,5 +28,6 @@ pub fn registry() -> Vec<Check> {
     checks.extend(lqg_exact::checks());
     checks.extend(sampled::checks());
     checks.extend(algorithm::checks());
+    checks.extend(certified::checks());
     checks
 }

@@ -330,6 +330,7 @@ impl SepgConfig {
         Ok(CheckedConfig {
             inner: self,
             constants,
+            certified: true,
         })
     }
 }
@@ -339,6 +340,7 @@ impl SepgConfig {
 pub struct CheckedConfig {
     inner: SepgConfig,
     constants: TaskConstants,
+    certified: bool,
 }
 
 impl CheckedConfig {
@@ -350,6 +352,30 @@ impl CheckedConfig {
     /// The validated task constants R, M_φ, |A|, γ of the environment (SPEC §1).
     pub fn constants(&self) -> &TaskConstants {
         &self.constants
+    }
+
+    /// Whether SEPG takes certified steps (`sepg_bounds::certified`, the default): every
+    /// v- and w-step, and the LV target, is a step whose bound, evaluated in outward-rounded
+    /// interval arithmetic with the inputs taken as exact, meets its requirement.
+    pub fn certified(&self) -> bool {
+        self.certified
+    }
+
+    /// Turns certified steps on (the default) or off. Off, SEPG takes the largest safe steps
+    /// as computed in `f64`, whose bound can fall short of the requirement by rounding.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+    /// use sepg_mdp::env::Preset;
+    /// let c = SepgConfig::new(Preset::Lqg.build(), Algorithm::Sepg(Requirement::Mi)).check()?;
+    /// assert!(c.certified());
+    /// assert!(!c.with_certified_steps(false).certified());
+    /// # Ok::<(), sepg_algo::core::error::ConfigError>(())
+    /// ```
+    pub fn with_certified_steps(mut self, on: bool) -> Self {
+        self.certified = on;
+        self
     }
 
     /// The state before the first iteration: (v⁰, ln σ⁰), B = B⁰.

@@ -125,6 +125,8 @@ pub(crate) fn iterate(
         below_noise_w: false,
         trajectories: state.trajectories + e.trajectories,
         steps: state.steps + e.steps,
+        certified_v: None,
+        certified_w: None,
     };
     state.iteration += 1;
     state.v = v_new;

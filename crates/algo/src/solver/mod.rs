@@ -47,6 +47,7 @@ pub struct PolicySolver {
     dims: (usize, usize),
     constants: TaskConstants,
     source: Box<dyn GradientSource>,
+    certified: bool,
 }
 
 impl std::fmt::Debug for PolicySolver {
@@ -107,6 +108,7 @@ impl PolicySolver {
             dims: (cfg.v0.len(), cfg.sigma0.len()),
             constants,
             source,
+            certified: config.certified(),
         })
     }
 }
@@ -135,6 +137,14 @@ pub struct CollectedConfig {
 }
 
 impl PolicySolver {
+    /// Turns certified steps (`sepg_bounds::certified`, on by default) on or off for this
+    /// solver, e.g. one built by [`PolicySolver::with_collector`]; see
+    /// [`CheckedConfig::with_certified_steps`].
+    pub fn with_certified_steps(mut self, on: bool) -> Self {
+        self.certified = on;
+        self
+    }
+
     /// The solver of `config` with every batch collected by `collector` and estimated by
     /// [`BlockEstimator`]: the same iteration code as [`PolicySolver::new`] in the sampled
     /// mode, so a collector that reproduces the built-in rollouts reproduces their records.
@@ -170,6 +180,7 @@ impl PolicySolver {
                 dims,
                 estimator,
             )),
+            certified: true,
         })
     }
 }
@@ -198,10 +209,17 @@ impl Solver for PolicySolver {
                 false,
                 self.n,
                 state,
+                self.certified,
             ),
-            Algorithm::SepgNaiveW(req) => {
-                sepg::iterate(&mut *self.source, &self.constants, req, true, self.n, state)
-            }
+            Algorithm::SepgNaiveW(req) => sepg::iterate(
+                &mut *self.source,
+                &self.constants,
+                req,
+                true,
+                self.n,
+                state,
+                self.certified,
+            ),
             other => baseline::iterate(&mut *self.source, &self.constants, other, self.n, state),
         }
     }

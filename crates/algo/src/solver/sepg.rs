@@ -25,6 +25,7 @@ struct BlockLog {
     guaranteed: Option<f64>,
     infeasible: bool,
     below_noise: bool,
+    certified: Option<bool>,
 }
 
 impl BlockLog {
@@ -40,6 +41,7 @@ impl BlockLog {
                 guaranteed: Some(s.guaranteed),
                 infeasible: s.infeasible,
                 below_noise: false,
+                certified: s.certified,
             },
         }
     }
@@ -56,7 +58,8 @@ fn min_sigma(w: &[f64]) -> f64 {
 }
 
 /// Runs SEPG iteration `state.iteration` for `req`; `naive_w` selects the w-update along
-/// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20).
+/// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20); `certify` selects certified steps
+/// (`sepg_bounds::certified`).
 pub(crate) fn iterate(
     source: &mut dyn GradientSource,
     k: &TaskConstants,
@@ -64,6 +67,7 @@ pub(crate) fn iterate(
     naive_w: bool,
     n: usize,
     state: &mut State,
+    certify: bool,
 ) -> Result<Record, RunError> {
     let t = state.iteration;
     let sizes = split(n, req.blocks());
@@ -133,7 +137,7 @@ pub(crate) fn iterate(
     let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
         "the v-block returned no gradient".into(),
     ))?;
-    let v_plan = steps::v_step(k, sigma, grad_v, required_v)?;
+    let v_plan = steps::v_step(k, sigma, grad_v, required_v, certify)?;
     let v_log = BlockLog::from_plan(&v_plan);
     let mut v_new = state.v.clone();
     apply(&mut v_new, &v_plan);
@@ -150,7 +154,8 @@ pub(crate) fn iterate(
                 "the v-block returned no w-gradient".into(),
             ))?;
             let mut wt = state.w.clone();
-            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, budget.required_improvement())?
+            if let Some((h, dw)) =
+                steps::lv_target(k, &sigmas, gwj, budget.required_improvement(), certify)?
             {
                 wt[h] += dw;
             }
@@ -178,7 +183,7 @@ pub(crate) fn iterate(
     let mut w_new = state.w.clone();
     let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
         let required_w = -(1.0 - nu) * budget.value();
-        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w)?;
+        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w, certify)?;
         apply(&mut w_new, &plan);
         (None, required_w, BlockLog::from_plan(&plan), j_t)
     } else {
@@ -195,7 +200,7 @@ pub(crate) fn iterate(
         // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
         budget.record_exploratory(ew.j).map_err(budget_error)?;
         let required_w = type_one.map_or(budget.required_improvement(), |(_, cw)| cw);
-        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w)?;
+        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w, certify)?;
         apply(&mut w_new, &plan);
         (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
     };
@@ -231,6 +236,8 @@ pub(crate) fn iterate(
         below_noise_w: w_log.below_noise,
         trajectories,
         steps: env_steps,
+        certified_v: v_log.certified,
+        certified_w: w_log.certified,
     };
     state.iteration += 1;
     state.v = v_new;
@@ -256,14 +263,15 @@ fn w_plan(
     e: &Estimate,
     required: f64,
     naive: bool,
+    certify: bool,
 ) -> Result<Plan, RunError> {
     let missing = || RunError::Estimator("the w-block returned no w-gradient".into());
     let gj = e.grad_wj.as_ref().ok_or_else(missing)?;
     if naive {
-        steps::w_step_naive(k, sigmas, gj, required)
+        steps::w_step_naive(k, sigmas, gj, required, certify)
     } else {
         let gl = e.grad_wl.as_ref().ok_or_else(missing)?;
-        steps::w_step_surrogate(k, sigmas, gl, gj, required)
+        steps::w_step_surrogate(k, sigmas, gl, gj, required, certify)
     }
 }
 

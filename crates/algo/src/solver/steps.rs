@@ -3,6 +3,9 @@
 //! Exact gradients use Theorems 4.2, 4.3 and 4.5 directly; estimated gradients use their
 //! high-probability versions (Theorems 4.7–4.9) in the sign-aware form, which keeps the
 //! guarantee for steps against the estimated direction (`HpForm::SignAware`, docs/THEOREMS.md).
+//! With certification on (the default), every step comes from `sepg_bounds::certified`: its
+//! bound, evaluated in interval arithmetic, meets the requirement.
+use sepg_bounds::certified::{self, Certified};
 use sepg_bounds::constants::{TaskConstants, c};
 use sepg_bounds::greedy::argmax_abs;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
@@ -43,6 +46,9 @@ pub struct Step {
     pub guaranteed: f64,
     /// The requirement was infeasible: the step of maximal guaranteed improvement was taken.
     pub infeasible: bool,
+    /// Whether the step's bound was certified in interval arithmetic to meet the requirement
+    /// (`None` when certification is off).
+    pub certified: Option<bool>,
 }
 
 /// What an update block does.
@@ -74,14 +80,51 @@ fn plan_from(
         lambda,
         guaranteed: bound(size).map_err(be)?,
         infeasible,
+        certified: None,
     }))
+}
+
+/// Turns a [`Certified`] outcome into a plan for coordinate `index` of direction `dir`; the
+/// guaranteed improvement is the lower end of the bound's enclosure. A requirement that no
+/// `f64` step can certify is handled like an infeasible one (vertex, flagged).
+fn plan_certified(outcome: Certified, index: usize, dir: f64) -> Plan {
+    let (size, lambda, bound, infeasible, certified) = match outcome {
+        Certified::Step(s) => (s.step, s.interval.lambda, s.bound, false, true),
+        Certified::Infeasible { step, bound } | Certified::Uncertifiable { step, bound } => {
+            (step, Some(0.0), bound, true, false)
+        }
+        _ => return Plan::BelowNoise,
+    };
+    Plan::Update(Step {
+        index,
+        size,
+        delta: size * dir,
+        lambda,
+        guaranteed: bound.lo(),
+        infeasible,
+        certified: Some(certified),
+    })
 }
 
 /// The greedy-coordinate v-update with the largest safe ᾱ for `required` (Theorem 4.2,
 /// eq. 4.10; Theorem 4.7, eq. 4.26 when estimated).
-pub fn v_step(k: &TaskConstants, sigma: f64, g: &Grad, required: f64) -> Result<Plan, RunError> {
+pub fn v_step(
+    k: &TaskConstants,
+    sigma: f64,
+    g: &Grad,
+    required: f64,
+    certify: bool,
+) -> Result<Plan, RunError> {
     let index = argmax_abs(&g.value).map_err(be)?;
     let dir = g.value[index];
+    if certify {
+        let outcome = if is_exact(g) {
+            certified::v_safe_step(k, sigma, &g.value, required)
+        } else {
+            certified::hp_v_safe_step(k, sigma, &g.value, eps_max(g), required, FORM)
+        };
+        return Ok(plan_certified(outcome.map_err(be)?, index, dir));
+    }
     if is_exact(g) {
         let outcome = v_update::safe_step(k, sigma, &g.value, required).map_err(be)?;
         plan_from(outcome, index, dir, |a| {
@@ -106,10 +149,24 @@ pub fn w_step_surrogate(
     gl: &Grad,
     gj: &Grad,
     required: f64,
+    certify: bool,
 ) -> Result<Plan, RunError> {
     let h = argmax_abs(&gl.value).map_err(be)?;
     let (s, l, j) = (sigmas[h], gl.value[h], gj.value[h]);
-    if is_exact(gl) && is_exact(gj) {
+    let exact = is_exact(gl) && is_exact(gj);
+    if certify {
+        if exact && l == 0.0 {
+            return Ok(Plan::BelowNoise);
+        }
+        let (ej, el) = (gj.eps[h], gl.eps[h]);
+        let outcome = if exact {
+            certified::w_safe_step_along_l(k, s, j, l, required)
+        } else {
+            certified::hp_w_safe_step_along_l(k, s, (j, ej), (l, el), required, FORM)
+        };
+        return Ok(plan_certified(outcome.map_err(be)?, h, l));
+    }
+    if exact {
         if l == 0.0 {
             return Ok(Plan::BelowNoise);
         }
@@ -132,9 +189,18 @@ pub fn w_step_naive(
     sigmas: &[f64],
     gj: &Grad,
     required: f64,
+    certify: bool,
 ) -> Result<Plan, RunError> {
     let h = argmax_abs(&gj.value).map_err(be)?;
     let (s, j) = (sigmas[h], gj.value[h]);
+    if certify {
+        let outcome = if is_exact(gj) {
+            certified::w_safe_step_along_j(k, s, j, required)
+        } else {
+            certified::hp_w_safe_step_along_j(k, s, j, gj.eps[h], required, FORM)
+        };
+        return Ok(plan_certified(outcome.map_err(be)?, h, j));
+    }
     if is_exact(gj) {
         let outcome = w_update::safe_step_along_j(k, s, j, required).map_err(be)?;
         plan_from(outcome, h, j, |b| w_update::bound_along_j(k, s, j, b))
@@ -161,6 +227,7 @@ pub fn lv_target(
     sigmas: &[f64],
     gj: &Grad,
     required: f64,
+    certify: bool,
 ) -> Result<Option<(usize, f64)>, RunError> {
     let h = argmax_abs(&gj.value).map_err(be)?;
     let (s, j) = (sigmas[h], gj.value[h]);
@@ -170,13 +237,32 @@ pub fn lv_target(
         hp::w_safe_step_along_j(k, s, j, gj.eps[h], required, FORM)
     }
     .map_err(be)?;
-    Ok(match outcome {
-        StepOutcome::Feasible(iv) => {
-            let dw = (iv.lo * j).min(iv.hi * j);
-            (dw < 0.0).then_some((h, dw))
+    let StepOutcome::Feasible(iv) = outcome else {
+        return Ok(None);
+    };
+    let end = if iv.lo * j <= iv.hi * j { iv.lo } else { iv.hi };
+    let end = if certify {
+        // move the chosen end toward the vertex until its bound is certified
+        let certified = if is_exact(gj) {
+            let q = certified::Quadratic::w_along_j(k, s, j).map_err(be)?;
+            certified::certify_toward(&q, end, iv.vertex, required)
+        } else {
+            let Some(b) =
+                certified::HpEnclosure::w_along_j(k, s, j, gj.eps[h], FORM).map_err(be)?
+            else {
+                return Ok(None);
+            };
+            certified::certify_toward(&b, end, iv.vertex, required)
+        };
+        match certified {
+            Ok((step, _, _)) => step,
+            Err(_) => return Ok(None),
         }
-        _ => None,
-    })
+    } else {
+        end
+    };
+    let dw = end * j;
+    Ok((dw < 0.0).then_some((h, dw)))
 }
 
 /// ∇_w L of Corollary 4.4 for each action dimension j, from ∇_v J and the mixed derivatives

@@ -2,6 +2,7 @@ mod batch_budget;
 mod common;
 mod errors;
 mod high_probability;
+mod interval;
 mod intervals;
 mod optimal_steps;
 mod properties;

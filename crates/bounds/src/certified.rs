@@ -1,0 +1,927 @@
+//! Certified safe steps: steps whose guarantee survives floating-point rounding.
+//!
+//! The safe steps of the other modules are computed in `f64`. Their largest step lies exactly
+//! on the boundary {B(x) = C} of the safe set, so rounding puts it outside the true safe set
+//! about half of the time: B(x) < C in real arithmetic by a few ulps, although the `f64`
+//! computation says B(x) ≥ C. This module evaluates each bound B at the returned step in
+//! interval arithmetic ([`Interval`]), with the inputs taken as exact reals and every
+//! irrational constant (ψ, √(2π), e^x) enclosed, and returns a step only when the lower end
+//! of the enclosure is at least C. When the computed step fails that test it is moved toward
+//! the vertex (the step of maximal guaranteed improvement) by the fewest ulps that pass; when
+//! no `f64` step between the computed one and the vertex passes, the outcome is
+//! [`Certified::Uncertifiable`]. docs/THEOREMS.md ("Certified steps") states what the
+//! certificate means and what it assumes.
+//!
+//! Each bound form is an [`EnclosedBound`]; [`certify`] turns the `f64` [`StepOutcome`] of
+//! any form into a [`Certified`] outcome, so a new step form is certified by implementing the
+//! trait for its bound.
+//!
+//! | function | bound | thesis |
+//! |---|---|---|
+//! | [`v_safe_step`] | α‖∇_vJ‖∞² − α²c‖∇_vJ‖∞² | Theorem 4.2 |
+//! | [`w_safe_step_along_j`] | β(∇_wJ)² − β²d(∇_wJ)² | Theorem 4.3 |
+//! | [`w_safe_step_along_l`] | β∇_wL∇_wJ − β²d(∇_wL)² | Theorem 4.5 |
+//! | [`hp_v_safe_step`], [`hp_w_safe_step_along_j`], [`hp_w_safe_step_along_l`] | high-probability forms | Theorems 4.7–4.9 |
+//! | [`rigorous_safe_step_along_j`], [`rigorous_safe_step_along_l`] | rigorous w-bound | [`crate::rigorous`] |
+
+use crate::constants::TaskConstants;
+use crate::error::{BoundsError, finite, finite_vector, inf_norm, positive};
+use crate::high_probability::{self as hp, HpForm};
+use crate::interval::{Interval, from_ordered_key, ordered_key};
+use crate::outcome::{SafeInterval, StepOutcome};
+use crate::{rigorous, v_update, w_update};
+
+/// Ulps walked one at a time around the predicted move before bisecting or doubling.
+const LOCAL_STEPS: u64 = 4;
+
+/// √(2π) ∈ [2.5066282746310002, 2.5066282746310007] (the two `f64` around it).
+const SQRT_2PI_LO: f64 = 2.506_628_274_631_000_2;
+const SQRT_2PI_HI: f64 = 2.506_628_274_631_000_7;
+/// ψ ∈ [0.5235570203213736, 0.5235570203213737] (Lemma A.1).
+const PSI_LO: f64 = 0.523_557_020_321_373_6;
+const PSI_HI: f64 = 0.523_557_020_321_373_7;
+
+/// An enclosure of √(2π): the two neighbouring `f64` around it.
+///
+/// ```
+/// let s = sepg_bounds::certified::sqrt_2pi();
+/// assert!(s.contains((2.0 * std::f64::consts::PI).sqrt()));
+/// assert!(s.width() < 1e-15);
+/// ```
+pub fn sqrt_2pi() -> Interval {
+    Interval::from_sorted(SQRT_2PI_LO, SQRT_2PI_HI)
+}
+
+/// An enclosure of ψ = 4(√7 − 2)e^{√7/2 − 2}/√(2π) of Lemma A.1 (see
+/// [`crate::constants::psi`]): the two neighbouring `f64` around it.
+///
+/// ```
+/// let p = sepg_bounds::certified::psi();
+/// assert!(p.lo() < p.hi() && p.width() < 1e-15);
+/// assert!((p.lo() - sepg_bounds::constants::psi()).abs() < 1e-15);
+/// ```
+pub fn psi() -> Interval {
+    Interval::from_sorted(PSI_LO, PSI_HI)
+}
+
+/// 1 − γ, enclosed.
+fn one_minus_gamma(k: &TaskConstants) -> Interval {
+    Interval::point(1.0) - Interval::point(k.gamma())
+}
+
+/// An enclosure of c(σ) of Theorems 3.14 / 4.2 (see [`crate::constants::c`]).
+///
+/// # Formula
+///
+/// ```text
+/// c(σ) = R M_φ² / ((1 − γ)² σ²) · ( |A| / (√(2π) σ) + γ / (2 (1 − γ)) )
+/// ```
+///
+/// Errors: σ not finite and positive.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::{self, TaskConstants}};
+/// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
+/// assert!(certified::c(&k, 0.3)?.contains(constants::c(&k, 0.3)?));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn c(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
+    positive("sigma", sigma)?;
+    let om = one_minus_gamma(k);
+    let s = Interval::point(sigma);
+    let front =
+        Interval::point(k.r_max()) * Interval::point(k.m_phi()).sqr() / (om.sqr() * s.sqr());
+    let bracket = Interval::point(k.action_volume()) / (sqrt_2pi() * s)
+        + Interval::point(k.gamma()) / (om + om);
+    Ok(front * bracket)
+}
+
+/// An enclosure of d(σ) of Theorem 4.3 (see [`crate::constants::d`]).
+///
+/// # Formula
+///
+/// ```text
+/// d(σ) = R / (1 − γ)² · ( ψ |A| / (2σ) + γ / (1 − γ) )
+/// ```
+///
+/// Errors: σ not finite and positive.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::{self, TaskConstants}};
+/// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
+/// assert!(certified::d(&k, 0.3)?.contains(constants::d(&k, 0.3)?));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
+    positive("sigma", sigma)?;
+    let om = one_minus_gamma(k);
+    let front = Interval::point(k.r_max()) / om.sqr();
+    let bracket = psi() * Interval::point(k.action_volume()) / Interval::point(sigma).scale(2.0)
+        + Interval::point(k.gamma()) / om;
+    Ok(front * bracket)
+}
+
+/// A bound B(x) on the guaranteed improvement of a step x that can be enclosed in interval
+/// arithmetic, with x taken as an exact real.
+///
+/// Implement it for a new step form and pass the form's `f64` [`StepOutcome`] to
+/// [`certify`].
+pub trait EnclosedBound {
+    /// An interval that contains the exact value B(x).
+    fn enclose(&self, x: f64) -> Interval;
+
+    /// An approximation of B'(x), used only to guess how far a failing step must move
+    /// (any value, or `None`, keeps [`certify`] correct; a good one makes it faster).
+    fn slope(&self, _x: f64) -> Option<f64> {
+        None
+    }
+}
+
+/// The concave parabola B(x) = a·x − b·x² (b ≥ 0) shared by Theorems 4.2, 4.3, 4.5, 4.7–4.9,
+/// with enclosed coefficients.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quadratic {
+    /// Enclosure of the linear coefficient a.
+    pub linear: Interval,
+    /// Enclosure of the quadratic coefficient b ≥ 0.
+    pub quadratic: Interval,
+}
+
+impl Quadratic {
+    /// Theorem 4.2: a = ‖∇_vJ‖∞², b = c(σ)‖∇_vJ‖∞².
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::{EnclosedBound, Quadratic}, constants::TaskConstants, v_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::v_update(&k, 1.0, &[0.3, -0.7])?;
+    /// assert!(q.enclose(0.01).contains(v_update::bound(&k, 1.0, &[0.3, -0.7], 0.01)?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn v_update(k: &TaskConstants, sigma: f64, grad_v: &[f64]) -> Result<Self, BoundsError> {
+        finite_vector("grad_v", grad_v)?;
+        let n2 = Interval::point(inf_norm(grad_v)).sqr();
+        Ok(Self {
+            linear: n2,
+            quadratic: c(k, sigma)? * n2,
+        })
+    }
+
+    /// Theorem 4.3: a = (∇_wJ)², b = d(σ)(∇_wJ)².
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::{EnclosedBound, Quadratic}, constants::TaskConstants, w_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::w_along_j(&k, 1.0, 0.3)?;
+    /// assert!(q.enclose(0.2).contains(w_update::bound_along_j(&k, 1.0, 0.3, 0.2)?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn w_along_j(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<Self, BoundsError> {
+        let g2 = Interval::point(finite("grad_w_j", grad_w_j)?).sqr();
+        Ok(Self {
+            linear: g2,
+            quadratic: d(k, sigma)? * g2,
+        })
+    }
+
+    /// Theorem 4.5: a = ∇_wL ∇_wJ, b = d(σ)(∇_wL)².
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::{EnclosedBound, Quadratic}, constants::TaskConstants, w_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::w_along_l(&k, 1.0, 0.3, -2.0)?;
+    /// assert!(q.enclose(-0.1).contains(w_update::bound_along_l(&k, 1.0, 0.3, -2.0, -0.1)?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn w_along_l(
+        k: &TaskConstants,
+        sigma: f64,
+        grad_w_j: f64,
+        grad_w_l: f64,
+    ) -> Result<Self, BoundsError> {
+        let j = Interval::point(finite("grad_w_j", grad_w_j)?);
+        let l = Interval::point(finite("grad_w_l", grad_w_l)?);
+        Ok(Self {
+            linear: l * j,
+            quadratic: d(k, sigma)? * l.sqr(),
+        })
+    }
+
+    /// An enclosure of C_max = a²/(4b), the value at the vertex.
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::Quadratic, constants::TaskConstants, v_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::v_update(&k, 1.0, &[0.5])?;
+    /// assert!(q.c_max().contains(v_update::c_max(&k, 1.0, &[0.5])?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn c_max(&self) -> Interval {
+        self.linear.sqr() / self.quadratic.scale(4.0)
+    }
+
+    /// An enclosure of the vertex a/(2b).
+    pub fn vertex(&self) -> Interval {
+        self.linear / self.quadratic.scale(2.0)
+    }
+
+    /// An enclosure of λ = √(1 − C/C_max) (eqs. (4.10), (4.17), (4.19)), for C ≤ C_max.
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::Quadratic, constants::TaskConstants, v_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::v_update(&k, 1.0, &[0.5])?;
+    /// let cmax = v_update::c_max(&k, 1.0, &[0.5])?;
+    /// assert!(q.lambda(0.75 * cmax).contains(0.5));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn lambda(&self, required: f64) -> Interval {
+        (Interval::point(1.0) - Interval::point(required) / self.c_max()).sqrt()
+    }
+
+    /// Enclosures of the two real end points of {x : a x − b x² ≥ C}, or `None` when the
+    /// enclosure cannot exclude C > C_max (no real end points).
+    ///
+    /// # Formula
+    ///
+    /// ```text
+    /// s = √(a² − 4bC);  a > 0: hi = (a + s)/(2b), lo = 2C/(a + s);
+    ///                   a < 0: lo = (a − s)/(2b), hi = 2C/(a − s)
+    /// ```
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::Quadratic, constants::TaskConstants, outcome::StepOutcome, v_update};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let q = Quadratic::v_update(&k, 1.0, &[0.5])?;
+    /// let StepOutcome::Feasible(s) = v_update::safe_step(&k, 1.0, &[0.5], 0.0)? else { panic!() };
+    /// let (lo, hi) = q.end_points(0.0).unwrap();
+    /// assert!(lo.contains(s.lo) && hi.contains(s.hi));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn end_points(&self, required: f64) -> Option<(Interval, Interval)> {
+        let cc = Interval::point(required);
+        let disc = self.linear.sqr() - self.quadratic.scale(4.0) * cc;
+        if disc.hi() < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        let two_b = self.quadratic.scale(2.0);
+        let two_c = cc.scale(2.0);
+        if self.linear.lo() > 0.0 {
+            let sum = self.linear + s;
+            Some((two_c / sum, sum / two_b))
+        } else if self.linear.hi() < 0.0 {
+            let diff = self.linear - s;
+            Some((diff / two_b, two_c / diff))
+        } else {
+            Some(((self.linear - s) / two_b, (self.linear + s) / two_b))
+        }
+    }
+}
+
+impl EnclosedBound for Quadratic {
+    #[inline]
+    fn enclose(&self, x: f64) -> Interval {
+        (self.linear - self.quadratic.scale(x)).scale(x)
+    }
+
+    fn slope(&self, x: f64) -> Option<f64> {
+        Some(self.linear.lo() - 2.0 * self.quadratic.lo() * x)
+    }
+}
+
+/// The high-probability bounds of Theorems 4.7–4.9 with enclosed coefficients, in either
+/// form of [`HpForm`] (see [`crate::high_probability`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HpEnclosure {
+    /// s = ±1, the direction the estimates favour.
+    pub direction: f64,
+    /// Enclosure of a⁻.
+    pub linear_lower: Interval,
+    /// Enclosure of a⁺.
+    pub linear_upper: Interval,
+    /// Enclosure of b.
+    pub quadratic: Interval,
+    /// Which form is evaluated.
+    pub form: HpForm,
+}
+
+/// Enclosures of (‖∇̂‖ − ε)² and (‖∇̂‖ + ε)² (Section 4.5); `None` when ‖∇̂‖ ≤ ε.
+fn corrected_squares(n: f64, eps: f64) -> Option<(Interval, Interval)> {
+    (n > eps).then(|| {
+        let (n, e) = (Interval::point(n), Interval::point(eps));
+        let lower = n - e;
+        // n > ε exactly, so the corrected norm is positive even if rounding says otherwise
+        let lower = Interval::new(lower.lo().max(0.0), lower.hi()).unwrap_or(lower);
+        (lower.sqr(), (n + e).sqr())
+    })
+}
+
+impl HpEnclosure {
+    /// Theorem 4.7: s = +1, a⁻ = (‖∇̂_vJ‖∞ − ε)², a⁺ = (‖∇̂_vJ‖∞ + ε)², b = c(σ)a⁺; `None`
+    /// when ‖∇̂_vJ‖∞ ≤ ε.
+    pub fn v_update(
+        k: &TaskConstants,
+        sigma: f64,
+        grad_v_hat: &[f64],
+        eps: f64,
+        form: HpForm,
+    ) -> Result<Option<Self>, BoundsError> {
+        finite_vector("grad_hat", grad_v_hat)?;
+        let cc = c(k, sigma)?;
+        Ok(
+            corrected_squares(inf_norm(grad_v_hat), eps).map(|(lower, upper)| Self {
+                direction: 1.0,
+                linear_lower: lower,
+                linear_upper: upper,
+                quadratic: cc * upper,
+                form,
+            }),
+        )
+    }
+
+    /// Theorem 4.8: s = +1, a⁻ = (|∇̂_wJ| − ε)², a⁺ = (|∇̂_wJ| + ε)², b = d(σ)a⁺.
+    pub fn w_along_j(
+        k: &TaskConstants,
+        sigma: f64,
+        grad_w_j_hat: f64,
+        eps: f64,
+        form: HpForm,
+    ) -> Result<Option<Self>, BoundsError> {
+        finite("grad_hat", grad_w_j_hat)?;
+        let dd = d(k, sigma)?;
+        Ok(
+            corrected_squares(grad_w_j_hat.abs(), eps).map(|(lower, upper)| Self {
+                direction: 1.0,
+                linear_lower: lower,
+                linear_upper: upper,
+                quadratic: dd * upper,
+                form,
+            }),
+        )
+    }
+
+    /// Theorem 4.9: s = sign(∇̂_wJ ∇̂_wL), a⁻ = L⁻J⁻, a⁺ = L⁺J⁺, b = d(σ)(L⁺)².
+    pub fn w_along_l(
+        k: &TaskConstants,
+        sigma: f64,
+        (grad_w_j_hat, eps_j): (f64, f64),
+        (grad_w_l_hat, eps_l): (f64, f64),
+        form: HpForm,
+    ) -> Result<Option<Self>, BoundsError> {
+        finite("grad_hat", grad_w_j_hat)?;
+        finite("grad_hat", grad_w_l_hat)?;
+        let dd = d(k, sigma)?;
+        let (nj, nl) = (grad_w_j_hat.abs(), grad_w_l_hat.abs());
+        if nj <= eps_j || nl <= eps_l {
+            return Ok(None);
+        }
+        let positive_part = |x: Interval| Interval::new(x.lo().max(0.0), x.hi()).unwrap_or(x);
+        let j_lo = positive_part(Interval::point(nj) - Interval::point(eps_j));
+        let l_lo = positive_part(Interval::point(nl) - Interval::point(eps_l));
+        let j_hi = Interval::point(nj) + Interval::point(eps_j);
+        let l_hi = Interval::point(nl) + Interval::point(eps_l);
+        let direction = if (grad_w_j_hat > 0.0) == (grad_w_l_hat > 0.0) {
+            1.0
+        } else {
+            -1.0
+        };
+        Ok(Some(Self {
+            direction,
+            linear_lower: l_lo * j_lo,
+            linear_upper: l_hi * j_hi,
+            quadratic: dd * l_hi.sqr(),
+            form,
+        }))
+    }
+
+    /// The parabola that the bound equals on the side of x.
+    fn side(&self, x: f64) -> Quadratic {
+        let favoured = self.direction * x >= 0.0;
+        let a = if favoured || self.form == HpForm::Thesis {
+            self.linear_lower
+        } else {
+            self.linear_upper
+        };
+        Quadratic {
+            linear: if self.direction > 0.0 { a } else { -a },
+            quadratic: self.quadratic,
+        }
+    }
+}
+
+impl EnclosedBound for HpEnclosure {
+    #[inline]
+    fn enclose(&self, x: f64) -> Interval {
+        self.side(x).enclose(x)
+    }
+
+    fn slope(&self, x: f64) -> Option<f64> {
+        self.side(x).slope(x)
+    }
+}
+
+/// The rigorous w-bound of [`crate::rigorous`] for Δw = β·u, enclosed.
+///
+/// ```text
+/// f(Δw) = Δw ∇_w J − a Δw² max(1, e^{−Δw}) − G · KL2(Δw),
+/// a = Rψ|A| / (2(1−γ)²σ),   G = γR / (2(1−γ)³)
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigorousEnclosure {
+    a: Interval,
+    g: Interval,
+    slope: f64,
+    direction: f64,
+}
+
+impl RigorousEnclosure {
+    /// The rigorous bound of a step β along the direction u (Δw = β·u): u = ∇_wJ for
+    /// [`rigorous::safe_step_along_j`], u = ∇_wL for [`rigorous::safe_step_along_l`].
+    ///
+    /// ```
+    /// use sepg_bounds::{certified::{EnclosedBound, RigorousEnclosure}, constants::TaskConstants, rigorous};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let r = RigorousEnclosure::new(&k, 1.0, 0.5, 0.5)?;
+    /// assert!(r.enclose(-0.2).contains(rigorous::bound(&k, 1.0, 0.5, -0.1)?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn new(
+        k: &TaskConstants,
+        sigma: f64,
+        grad_w_j: f64,
+        direction: f64,
+    ) -> Result<Self, BoundsError> {
+        positive("sigma", sigma)?;
+        let om = one_minus_gamma(k);
+        let r = Interval::point(k.r_max());
+        let a = r * psi() * Interval::point(k.action_volume())
+            / (om.sqr() * Interval::point(sigma).scale(2.0));
+        let g = Interval::point(k.gamma()) * r / (om.sqr() * om).scale(2.0);
+        Ok(Self {
+            a,
+            g,
+            slope: finite("grad_w_j", grad_w_j)?,
+            direction: finite("direction", direction)?,
+        })
+    }
+}
+
+/// Encloses KL2(t) = e^{−2t} − 1 + 2t at an exact t ≥ 0 (see [`rigorous::kl2`]).
+fn kl2_at(t: f64) -> Interval {
+    if t == 0.0 {
+        return Interval::point(0.0);
+    }
+    let y = Interval::point(t).scale(2.0);
+    if y.hi() < 0.1 {
+        // Σ_{n≥2} (−y)^n / n!: alternating with decreasing terms, so the tail after n = 17 lies
+        // between 0 and the first omitted term y^18/18!
+        let mut term = y.sqr() / Interval::point(2.0);
+        let mut sum = term;
+        for n in 3..18 {
+            term = -(term * y) / Interval::point(f64::from(n));
+            sum = sum + term;
+        }
+        let next = (term * y / Interval::point(18.0)).hi().abs();
+        sum + Interval::new(0.0, next).unwrap_or(Interval::ENTIRE)
+    } else {
+        (-y).exp_m1() + y
+    }
+}
+
+impl EnclosedBound for RigorousEnclosure {
+    fn enclose(&self, beta: f64) -> Interval {
+        if beta == 0.0 {
+            // f(0) = 0 exactly
+            return Interval::point(0.0);
+        }
+        let dw = Interval::point(beta).scale(self.direction);
+        let curvature = Interval::point(1.0).max((-dw).exp());
+        let (m_lo, m_hi) = if dw.lo() >= 0.0 {
+            (dw.lo(), dw.hi())
+        } else if dw.hi() <= 0.0 {
+            (-dw.hi(), -dw.lo())
+        } else {
+            (0.0, dw.lo().abs().max(dw.hi()))
+        };
+        let kl = Interval::new(kl2_at(m_lo).lo(), kl2_at(m_hi).hi()).unwrap_or(Interval::ENTIRE);
+        dw.scale(self.slope) - self.a * dw.sqr() * curvature - self.g * kl
+    }
+}
+
+/// A step whose bound is certified to meet the requirement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CertifiedStep {
+    /// The certified step x.
+    pub step: f64,
+    /// The enclosure of B(x); `bound.lo() ≥ required`.
+    pub bound: Interval,
+    /// How many ulps x was moved from the computed largest step toward the vertex.
+    pub ulps_moved: u64,
+    /// The safe interval computed in `f64` (λ, C_max and end points as computed).
+    pub interval: SafeInterval,
+}
+
+/// The outcome of a certified safe-step computation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Certified {
+    /// A step whose bound, evaluated in interval arithmetic, has a lower end ≥ C.
+    Step(CertifiedStep),
+    /// C > C_max: no step guarantees C. `step` is the vertex (the step of maximal guaranteed
+    /// improvement) and `bound` the enclosure of its guarantee, below C.
+    Infeasible {
+        /// The vertex.
+        step: f64,
+        /// Enclosure of the bound at the vertex.
+        bound: Interval,
+    },
+    /// C ≤ C_max as computed, but no `f64` step from the computed largest step to the vertex
+    /// has an enclosure with lower end ≥ C (C is within rounding of C_max). `step` is the
+    /// vertex and `bound` its enclosure.
+    Uncertifiable {
+        /// The vertex.
+        step: f64,
+        /// Enclosure of the bound at the vertex (it contains values below C).
+        bound: Interval,
+    },
+    /// The update direction is zero (bound identically 0): no step to certify.
+    ZeroGradient {
+        /// Whether C ≤ 0.
+        requirement_met: bool,
+    },
+    /// The estimate is within its confidence width (eq. (4.23) fails): no update.
+    BelowNoise,
+}
+
+impl Certified {
+    /// The step to take: the certified step, or the vertex when the requirement is infeasible
+    /// or uncertifiable; `None` when no update should be made.
+    ///
+    /// ```
+    /// use sepg_bounds::{certified, constants::TaskConstants};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let o = certified::v_safe_step(&k, 1.0, &[0.5], 0.0)?;
+    /// assert!(o.chosen_step().unwrap() > 0.0);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn chosen_step(&self) -> Option<f64> {
+        match self {
+            Self::Step(s) => Some(s.step),
+            Self::Infeasible { step, .. } | Self::Uncertifiable { step, .. } => Some(*step),
+            Self::ZeroGradient { .. } | Self::BelowNoise => None,
+        }
+    }
+
+    /// The enclosure of the bound at [`Self::chosen_step`] (`None` when there is no step).
+    pub fn bound(&self) -> Option<Interval> {
+        match self {
+            Self::Step(s) => Some(s.bound),
+            Self::Infeasible { bound, .. } | Self::Uncertifiable { bound, .. } => Some(*bound),
+            Self::ZeroGradient { .. } | Self::BelowNoise => None,
+        }
+    }
+
+    /// Whether a step was certified to meet the requirement.
+    pub fn is_certified(&self) -> bool {
+        matches!(self, Self::Step(_))
+    }
+}
+
+/// Certifies the `f64` outcome of a safe-step computation for the bound `bound` and the
+/// requirement C = `required`.
+///
+/// A feasible outcome's largest step `hi` is kept when `bound.enclose(hi).lo() ≥ C`;
+/// otherwise the step moves toward the vertex by doubling, then bisecting, the number of ulps
+/// (the enclosure's lower end grows toward the vertex up to its own rounding), and the first
+/// passing step is returned. An infeasible outcome returns the vertex with its enclosure.
+///
+/// ```
+/// use sepg_bounds::{certified::{self, Certified, Quadratic}, constants::TaskConstants, v_update};
+/// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
+/// let g = [0.7];
+/// let outcome = v_update::safe_step(&k, 0.5, &g, 0.0)?;
+/// let q = Quadratic::v_update(&k, 0.5, &g)?;
+/// let Certified::Step(s) = certified::certify(&q, outcome, 0.0) else { panic!() };
+/// assert!(s.bound.lo() >= 0.0 && s.step <= outcome.chosen_step().unwrap());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn certify<B: EnclosedBound + ?Sized>(
+    bound: &B,
+    outcome: StepOutcome,
+    required: f64,
+) -> Certified {
+    match outcome {
+        StepOutcome::Feasible(s) => match certify_toward(bound, s.hi, s.vertex, required) {
+            Ok((step, enclosure, ulps_moved)) => Certified::Step(CertifiedStep {
+                step,
+                bound: enclosure,
+                ulps_moved,
+                interval: s,
+            }),
+            Err(enclosure) => Certified::Uncertifiable {
+                step: s.vertex,
+                bound: enclosure,
+            },
+        },
+        StepOutcome::Infeasible { vertex, .. } => Certified::Infeasible {
+            step: vertex,
+            bound: bound.enclose(vertex),
+        },
+        StepOutcome::ZeroGradient { requirement_met } => {
+            Certified::ZeroGradient { requirement_met }
+        }
+        StepOutcome::BelowNoise => Certified::BelowNoise,
+    }
+}
+
+/// The first `f64` from `from` toward `toward` (both included) whose enclosure has lower end
+/// ≥ `required`: (step, enclosure, ulps moved), or the enclosure at `toward` if none passes.
+///
+/// [`certify`] uses it from the largest safe step toward the vertex; use it directly to
+/// certify another end point of a safe interval (e.g. the smallest step), moving toward the
+/// vertex too. The search doubles the number of ulps until a step passes, then bisects.
+///
+/// ```
+/// use sepg_bounds::{certified::{certify_toward, Quadratic}, constants::TaskConstants, outcome::StepOutcome, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let StepOutcome::Feasible(s) = w_update::safe_step_along_j(&k, 1.0, 0.3, -0.01)? else { panic!() };
+/// let q = Quadratic::w_along_j(&k, 1.0, 0.3)?;
+/// let (step, bound, _) = certify_toward(&q, s.lo, s.vertex, -0.01).unwrap();
+/// assert!(bound.lo() >= -0.01 && step >= s.lo);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn certify_toward<B: EnclosedBound + ?Sized>(
+    bound: &B,
+    from: f64,
+    toward: f64,
+    required: f64,
+) -> Result<(f64, Interval, u64), Interval> {
+    let first = bound.enclose(from);
+    if first.lo() >= required {
+        return Ok((from, first, 0));
+    }
+    let start = ordered_key(from);
+    let end = ordered_key(toward);
+    let total = end.abs_diff(start);
+    if total == 0 {
+        return Err(first);
+    }
+    let at = |offset: u64| {
+        let offset = offset as i64;
+        from_ordered_key(if end < start {
+            start - offset
+        } else {
+            start + offset
+        })
+    };
+    let passes = |offset: u64| {
+        let e = bound.enclose(at(offset));
+        (e.lo() >= required, e)
+    };
+    // Bracket the first passing offset: `failed` fails, `good` passes. Start from the move
+    // that the bound's slope predicts for the shortfall (usually within an ulp or two of the
+    // answer), walking one ulp at a time near it; fall back to doubling.
+    let guess = bound
+        .slope(from)
+        .map(|slope| (required - first.lo()) / (slope.abs() * (at(1) - from).abs()))
+        .filter(|g| g.is_finite() && *g >= 1.0)
+        .map_or(1, |g| (g.ceil() as u64).min(total));
+    let (mut failed, mut good, mut good_enclosure) = match passes(guess) {
+        (true, e) => {
+            let (mut good, mut good_enclosure) = (guess, e);
+            for _ in 0..LOCAL_STEPS {
+                if good == 1 {
+                    break;
+                }
+                match passes(good - 1) {
+                    (true, e) => (good, good_enclosure) = (good - 1, e),
+                    (false, _) => return Ok((at(good), good_enclosure, good)),
+                }
+            }
+            (0, good, good_enclosure)
+        }
+        (false, e) => {
+            let mut failed = guess;
+            let mut last = e;
+            let mut distance = 1_u64;
+            loop {
+                if failed == total {
+                    return Err(last);
+                }
+                let offset = failed.saturating_add(distance).min(total);
+                let (ok, e) = passes(offset);
+                if ok {
+                    break (failed, offset, e);
+                }
+                (failed, last) = (offset, e);
+                if distance < LOCAL_STEPS {
+                    distance += 1;
+                } else {
+                    distance = distance.saturating_mul(2);
+                }
+            }
+        }
+    };
+    while good - failed > 1 {
+        let mid = failed + (good - failed) / 2;
+        match passes(mid) {
+            (true, e) => (good, good_enclosure) = (mid, e),
+            (false, _) => failed = mid,
+        }
+    }
+    Ok((at(good), good_enclosure, good))
+}
+
+/// Certified safe v-step of Theorem 4.2 (eq. (4.10)) for the requirement C.
+///
+/// # Formula
+///
+/// ```text
+/// B(α) = α ‖∇_v J‖∞² − α² c(σ) ‖∇_v J‖∞²,   certified: enclosure of B(α) ≥ C
+/// ```
+///
+/// ```
+/// use sepg_bounds::{certified::{self, Certified}, constants::TaskConstants, v_update};
+/// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
+/// let cmax = v_update::c_max(&k, 1.0, &[0.8])?;
+/// assert!(certified::v_safe_step(&k, 1.0, &[0.8], 0.5 * cmax)?.is_certified());
+/// // C = C_max exactly cannot be certified in floating point
+/// let o = certified::v_safe_step(&k, 1.0, &[0.8], cmax)?;
+/// assert!(matches!(o, Certified::Uncertifiable { .. }));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn v_safe_step(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_v: &[f64],
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome = v_update::safe_step(k, sigma, grad_v, required)?;
+    Ok(certify(
+        &Quadratic::v_update(k, sigma, grad_v)?,
+        outcome,
+        required,
+    ))
+}
+
+/// Certified safe steps along ∇_w J, Theorem 4.3 (eq. (4.17)).
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert!(certified::w_safe_step_along_j(&k, 1.0, 0.3, 0.0)?.is_certified());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn w_safe_step_along_j(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome = w_update::safe_step_along_j(k, sigma, grad_w_j, required)?;
+    Ok(certify(
+        &Quadratic::w_along_j(k, sigma, grad_w_j)?,
+        outcome,
+        required,
+    ))
+}
+
+/// Certified safe steps along ∇_w L, Theorem 4.5 (eq. (4.19)).
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::w_safe_step_along_l(&k, 1.0, 0.3, -2.0, -0.1)?;
+/// assert!(o.is_certified() && o.bound().unwrap().lo() >= -0.1);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn w_safe_step_along_l(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome = w_update::safe_step_along_l(k, sigma, grad_w_j, grad_w_l, required)?;
+    Ok(certify(
+        &Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l)?,
+        outcome,
+        required,
+    ))
+}
+
+/// Certifies a high-probability outcome, or passes `BelowNoise` through.
+fn certify_hp(enclosure: Option<HpEnclosure>, outcome: StepOutcome, required: f64) -> Certified {
+    match enclosure {
+        Some(e) => certify(&e, outcome, required),
+        None => Certified::BelowNoise,
+    }
+}
+
+/// Certified high-probability v-step, Theorem 4.7 (eq. (4.26)), in the form `form`.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants, high_probability::HpForm};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert!(certified::hp_v_safe_step(&k, 1.0, &[0.5], 0.1, 0.0, HpForm::SignAware)?.is_certified());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn hp_v_safe_step(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_v_hat: &[f64],
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    let outcome = hp::v_safe_step(k, sigma, grad_v_hat, eps, required, form)?;
+    let enclosure = HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form)?;
+    Ok(certify_hp(enclosure, outcome, required))
+}
+
+/// Certified high-probability step along ∇̂_w J, Theorem 4.8 (eq. (4.29)).
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants, high_probability::HpForm};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::hp_w_safe_step_along_j(&k, 1.0, 0.5, 0.1, -0.01, HpForm::SignAware)?;
+/// assert!(o.is_certified());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn hp_w_safe_step_along_j(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j_hat: f64,
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    let outcome = hp::w_safe_step_along_j(k, sigma, grad_w_j_hat, eps, required, form)?;
+    let enclosure = HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form)?;
+    Ok(certify_hp(enclosure, outcome, required))
+}
+
+/// Certified high-probability step along ∇̂_w L, Theorem 4.9 (eq. (4.30)); the estimates
+/// come as (value, width) pairs.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants, high_probability::HpForm};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::hp_w_safe_step_along_l(&k, 1.0, (0.5, 0.1), (-2.0, 0.5), -0.01, HpForm::SignAware)?;
+/// assert!(o.chosen_step().unwrap() > 0.0);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn hp_w_safe_step_along_l(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j_hat: (f64, f64),
+    grad_w_l_hat: (f64, f64),
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    let (j, ej) = grad_w_j_hat;
+    let (l, el) = grad_w_l_hat;
+    let outcome = hp::w_safe_step_along_l(k, sigma, j, ej, l, el, required, form)?;
+    let enclosure = HpEnclosure::w_along_l(k, sigma, grad_w_j_hat, grad_w_l_hat, form)?;
+    Ok(certify_hp(enclosure, outcome, required))
+}
+
+/// Certified rigorous steps along ∇_w J ([`rigorous::safe_step_along_j`]).
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// assert!(certified::rigorous_safe_step_along_j(&k, 1.0, 0.5, 0.0)?.is_certified());
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn rigorous_safe_step_along_j(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome = rigorous::safe_step_along_j(k, sigma, grad_w_j, required)?;
+    let enclosure = RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_j)?;
+    Ok(certify(&enclosure, outcome, required))
+}
+
+/// Certified rigorous steps along ∇_w L ([`rigorous::safe_step_along_l`]).
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::rigorous_safe_step_along_l(&k, 1.0, 0.5, -3.0, -0.01)?;
+/// assert!(o.chosen_step().unwrap() > 0.0);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn rigorous_safe_step_along_l(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome = rigorous::safe_step_along_l(k, sigma, grad_w_j, grad_w_l, required)?;
+    let enclosure = RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_l)?;
+    Ok(certify(&enclosure, outcome, required))
+}

@@ -1,0 +1,639 @@
+//! The exact-arithmetic campaign for certified safe steps (`sepg_bounds::certified`).
+//!
+//! For every input configuration and every bound form, the largest safe step computed in
+//! `f64` (uncertified) and the certified step are evaluated in multiple-precision interval
+//! arithmetic ([`mp`]), with the `f64` inputs and the step taken as exact dyadic rationals and
+//! every irrational constant (π, √7, e^x, hence √(2π) and ψ) enclosed by series with rigorous
+//! remainders. The bound formulas here are written from the thesis, independently of
+//! `sepg-bounds`. A step *violates* its requirement C when the enclosure of B(step) lies
+//! entirely below C; it is *proven* when the enclosure lies entirely at or above C; anything
+//! else is *undecided* (reported, and counted as a failure of the campaign).
+//!
+//! Configurations are random (log-uniform constants, σ, gradients with both signs, subnormal
+//! and huge gradients, requirements C = C_max·(1 − k·2⁻⁵²), C_max/2, 0, −C_max, −10·C_max)
+//! or adversarial (a fixed grid of extreme values). Every chunk of 256 configurations has its
+//! own Xoshiro256++ stream derived from (seed, chunk), so the tallies do not depend on the
+//! number of threads.
+
+mod mp;
+
+use std::cell::OnceCell;
+
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use sepg_bounds::certified::{self, Certified};
+use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
+use sepg_bounds::outcome::StepOutcome;
+use sepg_bounds::{rigorous, v_update, w_update};
+
+use crate::check::splitmix64;
+use mp::{Dyadic, Mp};
+
+/// Configurations per random stream.
+const CHUNK: u64 = 256;
+
+/// Which configurations to draw.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CampaignConfig {
+    /// Master seed of the random configurations.
+    pub seed: u64,
+    /// Number of random configurations (each is tried with every bound form).
+    pub random: u64,
+    /// Whether to add the fixed adversarial grid.
+    pub adversarial: bool,
+}
+
+/// What the campaign found for one bound form.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct FormTally {
+    /// The bound form (thesis theorem).
+    pub form: &'static str,
+    /// Configurations tried.
+    pub cases: u64,
+    /// Feasible requirements: uncertified largest steps evaluated exactly.
+    pub uncertified_steps: u64,
+    /// Uncertified steps whose bound is below C in exact arithmetic.
+    pub uncertified_violations: u64,
+    /// Certified steps evaluated exactly.
+    pub certified_steps: u64,
+    /// Certified steps whose bound is below C in exact arithmetic (must be 0).
+    pub certified_violations: u64,
+    /// Certified steps whose comparison with C the 256-bit enclosure could not decide.
+    pub undecided: u64,
+    /// Returned enclosures that do not contain the exact bound (must be 0).
+    pub enclosure_failures: u64,
+    /// Feasible requirements that no `f64` step could certify.
+    pub uncertifiable: u64,
+    /// Certified steps that had to move from the computed step.
+    pub moved: u64,
+    /// Largest move, in ulps.
+    pub max_ulps: u64,
+    /// The configuration of the largest move.
+    pub largest_move: Option<String>,
+    /// The first failing configuration (lowest case index), if any.
+    pub counterexample: Option<String>,
+}
+
+impl FormTally {
+    fn merge(&mut self, o: FormTally) {
+        self.cases += o.cases;
+        self.uncertified_steps += o.uncertified_steps;
+        self.uncertified_violations += o.uncertified_violations;
+        self.certified_steps += o.certified_steps;
+        self.certified_violations += o.certified_violations;
+        self.undecided += o.undecided;
+        self.enclosure_failures += o.enclosure_failures;
+        self.uncertifiable += o.uncertifiable;
+        self.moved += o.moved;
+        if o.max_ulps > self.max_ulps {
+            self.max_ulps = o.max_ulps;
+            self.largest_move = o.largest_move;
+        }
+        if self.counterexample.is_none() {
+            self.counterexample = o.counterexample;
+        }
+    }
+
+    /// Whether every certified step was proven safe and every enclosure held.
+    pub fn clean(&self) -> bool {
+        self.certified_violations == 0 && self.undecided == 0 && self.enclosure_failures == 0
+    }
+}
+
+/// The names of the forms, in report order.
+pub const FORMS: [&str; 11] = [
+    "Thm 4.2 v-step",
+    "Thm 4.3 w along J",
+    "Thm 4.5 w along L",
+    "Thm 4.7 v (sign-aware)",
+    "Thm 4.7 v (thesis form)",
+    "Thm 4.8 w along J (sign-aware)",
+    "Thm 4.9 w along L (sign-aware)",
+    "Thm 4.9 w along L (thesis form)",
+    "rigorous w along J",
+    "rigorous w along L",
+    "Thm 4.8 w along J (thesis form)",
+];
+
+/// One input configuration.
+#[derive(Debug, Clone, PartialEq)]
+struct Case {
+    gamma: f64,
+    r_max: f64,
+    m_phi: f64,
+    volume: f64,
+    sigma: f64,
+    grad_v: Vec<f64>,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    eps_v: f64,
+    eps_j: f64,
+    eps_l: f64,
+    /// How C is chosen from the form's C_max.
+    requirement: Requirement,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Requirement {
+    /// C = C_max·(1 − k·2⁻⁵²).
+    NearMax(u32),
+    /// C = C_max · factor.
+    Scaled(f64),
+}
+
+impl Requirement {
+    fn of(self, c_max: f64) -> f64 {
+        match self {
+            Requirement::NearMax(k) => c_max * (1.0 - f64::from(k) * f64::EPSILON),
+            Requirement::Scaled(f) => c_max * f,
+        }
+    }
+}
+
+fn log_uniform(rng: &mut Xoshiro256PlusPlus, lo: f64, hi: f64) -> f64 {
+    10f64.powf(rng.random_range(lo..hi))
+}
+
+fn gradient(rng: &mut Xoshiro256PlusPlus) -> f64 {
+    let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
+    let u: f64 = rng.random();
+    let magnitude = if u < 0.02 {
+        f64::from_bits(rng.random_range(1..(1u64 << 52)))
+    } else if u < 0.04 {
+        log_uniform(rng, 100.0, 150.0)
+    } else {
+        log_uniform(rng, -12.0, 6.0)
+    };
+    sign * magnitude
+}
+
+fn requirement(rng: &mut Xoshiro256PlusPlus) -> Requirement {
+    match rng.random_range(0..6) {
+        0 | 1 => Requirement::NearMax(rng.random_range(0..=16)),
+        2 => Requirement::Scaled(0.5),
+        3 => Requirement::Scaled(0.0),
+        4 => Requirement::Scaled(-1.0),
+        _ => Requirement::Scaled(-10.0 * rng.random::<f64>()),
+    }
+}
+
+fn random_case(rng: &mut Xoshiro256PlusPlus) -> Case {
+    let u: f64 = rng.random();
+    let gamma = if u < 0.05 {
+        0.0
+    } else if u < 0.3 {
+        1.0 - log_uniform(rng, -6.0, 0.0)
+    } else {
+        rng.random_range(0.0..1.0)
+    };
+    let s: f64 = rng.random();
+    let sigma = if s < 0.05 {
+        log_uniform(rng, -10.0, -4.0)
+    } else if s < 0.1 {
+        log_uniform(rng, 2.0, 6.0)
+    } else {
+        log_uniform(rng, -4.0, 2.0)
+    };
+    let dim = rng.random_range(1..=3);
+    let grad_v: Vec<f64> = (0..dim).map(|_| gradient(rng)).collect();
+    let grad_w_j = gradient(rng);
+    let grad_w_l = gradient(rng);
+    let norm_v = grad_v.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
+    let eps_v = norm_v * rng.random_range(0.0..1.2);
+    let eps_j = grad_w_j.abs() * rng.random_range(0.0..1.2);
+    let eps_l = grad_w_l.abs() * rng.random_range(0.0..1.2);
+    Case {
+        gamma,
+        r_max: log_uniform(rng, -3.0, 3.0),
+        m_phi: log_uniform(rng, -3.0, 3.0),
+        volume: log_uniform(rng, -3.0, 3.0),
+        sigma,
+        grad_v,
+        grad_w_j,
+        grad_w_l,
+        eps_v,
+        eps_j,
+        eps_l,
+        requirement: requirement(rng),
+    }
+}
+
+/// The fixed adversarial grid: extreme σ, γ, huge and subnormal gradients with mixed signs,
+/// and C within 32 ulps of C_max.
+fn adversarial_cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    let gammas = [0.0, 0.5, 0.99, 0.999_999];
+    let sigmas = [1e-10, 1e-6, 0.1, 1.0, 1e4, 1e6];
+    let grads: [(&[f64], f64, f64); 5] = [
+        (&[0.7], 0.3, -2.0),
+        (&[1e-300, -3.0, 2.5], -1e-3, 4.0),
+        (&[5e-324], 1e-310, -5e-324),
+        (&[-1e150, 1e149], 1e150, 1e-150),
+        (&[-2.5e-7, 2.5e-7], -7e5, -7e5),
+    ];
+    let requirements = [0, 1, 2, 3, 4, 8, 16, 32]
+        .map(Requirement::NearMax)
+        .into_iter()
+        .chain([0.5, 0.0, -1.0, -10.0].map(Requirement::Scaled));
+    for requirement in requirements {
+        for &gamma in &gammas {
+            for &sigma in &sigmas {
+                for &(gv, gj, gl) in &grads {
+                    let norm_v = gv.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
+                    out.push(Case {
+                        gamma,
+                        r_max: 4.0,
+                        m_phi: 2.0,
+                        volume: 4.0,
+                        sigma,
+                        grad_v: gv.to_vec(),
+                        grad_w_j: gj,
+                        grad_w_l: gl,
+                        eps_v: norm_v / 3.0,
+                        eps_j: gj.abs() / 3.0,
+                        eps_l: gl.abs() / 3.0,
+                        requirement,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Exact task constants of a case, with c and d computed once.
+struct Exact {
+    gamma: Mp,
+    one_minus: Mp,
+    r: Mp,
+    m: Mp,
+    volume: Mp,
+    sigma: Mp,
+    c: OnceCell<Option<Mp>>,
+    d: OnceCell<Option<Mp>>,
+}
+
+impl Exact {
+    fn new(c: &Case) -> Self {
+        Self {
+            gamma: Mp::f(c.gamma),
+            one_minus: Mp::int(1).sub(&Mp::f(c.gamma)),
+            r: Mp::f(c.r_max),
+            m: Mp::f(c.m_phi),
+            volume: Mp::f(c.volume),
+            sigma: Mp::f(c.sigma),
+            c: OnceCell::new(),
+            d: OnceCell::new(),
+        }
+    }
+
+    fn c(&self) -> Option<Mp> {
+        self.c.get_or_init(|| self.c_uncached()).clone()
+    }
+
+    fn d(&self) -> Option<Mp> {
+        self.d.get_or_init(|| self.d_uncached()).clone()
+    }
+
+    /// c(σ) = R M²/((1−γ)²σ²) · (|A|/(√(2π)σ) + γ/(2(1−γ))), Theorem 4.2.
+    fn c_uncached(&self) -> Option<Mp> {
+        let front = self
+            .r
+            .mul(&self.m.sqr())
+            .div(&self.one_minus.sqr().mul(&self.sigma.sqr()))?;
+        let box_term = self.volume.div(&mp::sqrt_2pi().mul(&self.sigma))?;
+        let discount = self.gamma.div(&self.one_minus.ldexp(1))?;
+        Some(front.mul(&box_term.add(&discount)))
+    }
+
+    /// d(σ) = R/(1−γ)² · (ψ|A|/(2σ) + γ/(1−γ)), Theorem 4.3.
+    fn d_uncached(&self) -> Option<Mp> {
+        let front = self.r.div(&self.one_minus.sqr())?;
+        let box_term = mp::psi().mul(&self.volume).div(&self.sigma.ldexp(1))?;
+        Some(front.mul(&box_term.add(&self.gamma.div(&self.one_minus)?)))
+    }
+
+    /// The rigorous w-bound f(Δw) = Δw ∇_wJ − a Δw² max(1, e^{−Δw}) − G·KL2(Δw) with
+    /// a = Rψ|A|/(2(1−γ)²σ), G = γR/(2(1−γ)³), at the exact Δw = β·u.
+    fn rigorous(&self, grad_w_j: f64, beta: f64, u: f64) -> Option<Mp> {
+        let dw = Dyadic::product(beta, u);
+        let kl = mp::kl2(&dw.abs());
+        let dw = Mp::point(dw);
+        let a = self
+            .r
+            .mul(mp::psi())
+            .mul(&self.volume)
+            .div(&self.one_minus.sqr().mul(&self.sigma).ldexp(1))?;
+        let g = self
+            .gamma
+            .mul(&self.r)
+            .div(&self.one_minus.sqr().mul(&self.one_minus).ldexp(1))?;
+        // max(1, e^{−Δw}) = 1 for Δw ≥ 0
+        let curvature = if beta * u >= 0.0 {
+            Mp::int(1)
+        } else {
+            Mp::int(1).max(&dw.neg().exp()?)
+        };
+        Some(
+            dw.mul(&Mp::f(grad_w_j))
+                .sub(&a.mul(&dw.sqr()).mul(&curvature))
+                .sub(&g.mul(&kl)),
+        )
+    }
+}
+
+/// The parabola s·x·a − x²·b at the exact step x.
+fn parabola(x: f64, linear: &Mp, quadratic: &Mp) -> Mp {
+    let x = Mp::f(x);
+    x.mul(linear).sub(&x.sqr().mul(quadratic))
+}
+
+/// A high-probability bound at x: the thesis form s·x·a⁻ − x²b everywhere, the sign-aware
+/// form −|x|·a⁺ − x²b for steps against the favoured direction s.
+fn high_probability(x: f64, s: f64, lower: &Mp, upper: &Mp, b: &Mp, sign_aware: bool) -> Mp {
+    if sign_aware && s * x < 0.0 {
+        // −|x| a⁺ = s·x·a⁺ when s·x < 0
+        let a = if s > 0.0 { upper.clone() } else { upper.neg() };
+        parabola(x, &a, b)
+    } else {
+        let a = if s > 0.0 { lower.clone() } else { lower.neg() };
+        parabola(x, &a, b)
+    }
+}
+
+/// (|ĝ| − ε, |ĝ| + ε) exactly.
+fn corrected(g: f64, eps: f64) -> (Mp, Mp) {
+    let n = Mp::f(g.abs());
+    let e = Mp::f(eps);
+    (n.sub(&e), n.add(&e))
+}
+
+fn inf_norm(g: &[f64]) -> f64 {
+    g.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// The `f64` outcomes of one form: (C, uncertified outcome, certified outcome).
+type Outcomes = (f64, StepOutcome, Certified);
+
+/// Runs form `form` on a case in `f64`; `None` when an input is rejected (overflow).
+fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
+    let (s, g, j, l) = (c.sigma, &c.grad_v[..], c.grad_w_j, c.grad_w_l);
+    let sa = HpForm::SignAware;
+    let th = HpForm::Thesis;
+    let hp_c_max = |b: Option<HighProbabilityBound>| b.map_or(0.0, |b| b.c_max());
+    let result = match form {
+        0 => {
+            let req = c.requirement.of(v_update::c_max(k, s, g).ok()?);
+            (
+                req,
+                v_update::safe_step(k, s, g, req).ok()?,
+                certified::v_safe_step(k, s, g, req).ok()?,
+            )
+        }
+        1 => {
+            let req = c.requirement.of(w_update::c_max(k, s, j).ok()?);
+            (
+                req,
+                w_update::safe_step_along_j(k, s, j, req).ok()?,
+                certified::w_safe_step_along_j(k, s, j, req).ok()?,
+            )
+        }
+        2 => {
+            let req = c.requirement.of(w_update::c_max(k, s, j).ok()?);
+            (
+                req,
+                w_update::safe_step_along_l(k, s, j, l, req).ok()?,
+                certified::w_safe_step_along_l(k, s, j, l, req).ok()?,
+            )
+        }
+        3 | 4 => {
+            let form = if form == 3 { sa } else { th };
+            let b = HighProbabilityBound::v_update(k, s, g, c.eps_v).ok()?;
+            let req = c.requirement.of(hp_c_max(b));
+            (
+                req,
+                hp::v_safe_step(k, s, g, c.eps_v, req, form).ok()?,
+                certified::hp_v_safe_step(k, s, g, c.eps_v, req, form).ok()?,
+            )
+        }
+        5 | 10 => {
+            let form = if form == 5 { sa } else { th };
+            let b = HighProbabilityBound::w_along_j(k, s, j, c.eps_j).ok()?;
+            let req = c.requirement.of(hp_c_max(b));
+            (
+                req,
+                hp::w_safe_step_along_j(k, s, j, c.eps_j, req, form).ok()?,
+                certified::hp_w_safe_step_along_j(k, s, j, c.eps_j, req, form).ok()?,
+            )
+        }
+        6 | 7 => {
+            let form = if form == 6 { sa } else { th };
+            let b = HighProbabilityBound::w_along_l(k, s, j, c.eps_j, l, c.eps_l).ok()?;
+            let req = c.requirement.of(hp_c_max(b));
+            (
+                req,
+                hp::w_safe_step_along_l(k, s, j, c.eps_j, l, c.eps_l, req, form).ok()?,
+                certified::hp_w_safe_step_along_l(k, s, (j, c.eps_j), (l, c.eps_l), req, form)
+                    .ok()?,
+            )
+        }
+        8 => {
+            let c_max = rigorous::safe_step_along_j(k, s, j, 0.0).ok()?.c_max()?;
+            let req = c.requirement.of(c_max);
+            (
+                req,
+                rigorous::safe_step_along_j(k, s, j, req).ok()?,
+                certified::rigorous_safe_step_along_j(k, s, j, req).ok()?,
+            )
+        }
+        _ => {
+            let c_max = rigorous::safe_step_along_l(k, s, j, l, 0.0).ok()?.c_max()?;
+            let req = c.requirement.of(c_max);
+            (
+                req,
+                rigorous::safe_step_along_l(k, s, j, l, req).ok()?,
+                certified::rigorous_safe_step_along_l(k, s, j, l, req).ok()?,
+            )
+        }
+    };
+    result
+        .1
+        .c_max()
+        .is_none_or(f64::is_finite)
+        .then_some(result)
+}
+
+/// The exact bound of form `form` at the step x.
+fn exact_bound(form: usize, c: &Case, ex: &Exact, x: f64) -> Option<Mp> {
+    let (j, l) = (c.grad_w_j, c.grad_w_l);
+    Some(match form {
+        0 => {
+            let n2 = Mp::f(inf_norm(&c.grad_v)).sqr();
+            parabola(x, &n2, &ex.c()?.mul(&n2))
+        }
+        1 => {
+            let g2 = Mp::f(j).sqr();
+            parabola(x, &g2, &ex.d()?.mul(&g2))
+        }
+        2 => parabola(x, &Mp::f(l).mul(&Mp::f(j)), &ex.d()?.mul(&Mp::f(l).sqr())),
+        3 | 4 => {
+            let (lo, hi) = corrected(inf_norm(&c.grad_v), c.eps_v);
+            let upper = hi.sqr();
+            let b = ex.c()?.mul(&upper);
+            high_probability(x, 1.0, &lo.sqr(), &upper, &b, form == 3)
+        }
+        5 | 10 => {
+            let (lo, hi) = corrected(j, c.eps_j);
+            let upper = hi.sqr();
+            let b = ex.d()?.mul(&upper);
+            high_probability(x, 1.0, &lo.sqr(), &upper, &b, form == 5)
+        }
+        6 | 7 => {
+            let (j_lo, j_hi) = corrected(j, c.eps_j);
+            let (l_lo, l_hi) = corrected(l, c.eps_l);
+            let s = if (j > 0.0) == (l > 0.0) { 1.0 } else { -1.0 };
+            let b = ex.d()?.mul(&l_hi.sqr());
+            high_probability(x, s, &l_lo.mul(&j_lo), &l_hi.mul(&j_hi), &b, form == 6)
+        }
+        8 => ex.rigorous(j, x, j)?,
+        _ => ex.rigorous(j, x, l)?,
+    })
+}
+
+/// Tallies one form on one case.
+fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
+    t.cases += 1;
+    let Ok(k) = TaskConstants::new(c.gamma, c.r_max, c.m_phi, c.volume) else {
+        return;
+    };
+    let Some((required, uncertified, certified)) = outcomes(form, c, &k) else {
+        return;
+    };
+    let cc = Mp::f(required);
+    if let StepOutcome::Feasible(s) = uncertified
+        && let Some(b) = exact_bound(form, c, ex, s.hi)
+    {
+        t.uncertified_steps += 1;
+        if b.certainly_lt(&cc) {
+            t.uncertified_violations += 1;
+        }
+    }
+    let (Some(step), Some(enclosure)) = (certified.chosen_step(), certified.bound()) else {
+        return;
+    };
+    let Some(b) = exact_bound(form, c, ex, step) else {
+        return;
+    };
+    let mut failure = None;
+    if !b.inside(enclosure.lo(), enclosure.hi()) {
+        t.enclosure_failures += 1;
+        failure = Some("enclosure misses the exact bound");
+    }
+    match certified {
+        Certified::Step(st) => {
+            t.certified_steps += 1;
+            if st.ulps_moved > 0 {
+                t.moved += 1;
+                if st.ulps_moved > t.max_ulps {
+                    t.max_ulps = st.ulps_moved;
+                    t.largest_move = Some(format!(
+                        "case {index} {c:?}: C {required:e}, f64 interval {:?}, certified {step:e}",
+                        st.interval
+                    ));
+                }
+            }
+            if b.certainly_lt(&cc) {
+                t.certified_violations += 1;
+                failure = Some("certified step violates C");
+            } else if !b.certainly_ge(&cc) {
+                t.undecided += 1;
+                failure = Some("undecided at 256 bits");
+            }
+        }
+        Certified::Uncertifiable { .. } => t.uncertifiable += 1,
+        _ => {}
+    }
+    if let (Some(why), None) = (failure, &t.counterexample) {
+        t.counterexample = Some(format!(
+            "{why}: case {index} {c:?}, step {step:e}, C {required:e}, exact bound ≈ {:e},              enclosure [{:e}, {:e}]",
+            b.approx(),
+            enclosure.lo(),
+            enclosure.hi()
+        ));
+    }
+}
+
+fn empty() -> Vec<FormTally> {
+    FORMS
+        .iter()
+        .map(|&form| FormTally {
+            form,
+            ..FormTally::default()
+        })
+        .collect()
+}
+
+fn run_cases(cases: impl Iterator<Item = (u64, Case)>) -> Vec<FormTally> {
+    let mut tallies = empty();
+    for (index, case) in cases {
+        let ex = Exact::new(&case);
+        for (form, t) in tallies.iter_mut().enumerate() {
+            tally(t, form, index, &case, &ex);
+        }
+    }
+    tallies
+}
+
+/// Runs the campaign: every form on every configuration, in parallel over chunks of 256
+/// random configurations with their own streams (results independent of thread count).
+///
+/// ```
+/// use sepg_verification::campaign::{run, CampaignConfig};
+/// let tallies = run(&CampaignConfig { seed: 1, random: 64, adversarial: false });
+/// assert!(tallies.iter().all(|t| t.clean() && t.cases == 64));
+/// ```
+pub fn run(config: &CampaignConfig) -> Vec<FormTally> {
+    let chunks = config.random.div_ceil(CHUNK);
+    let seed = config.seed;
+    let total = config.random;
+    let mut parts: Vec<Vec<FormTally>> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(splitmix64(seed ^ splitmix64(chunk)));
+            let start = chunk * CHUNK;
+            let end = (start + CHUNK).min(total);
+            run_cases((start..end).map(|i| (i, random_case(&mut rng))))
+        })
+        .collect();
+    if config.adversarial {
+        let cases = adversarial_cases();
+        parts.extend(
+            cases
+                .par_chunks(64)
+                .enumerate()
+                .map(|(chunk, cs)| {
+                    let base = total + (chunk * 64) as u64;
+                    run_cases(
+                        cs.iter()
+                            .enumerate()
+                            .map(|(i, c)| (base + i as u64, c.clone())),
+                    )
+                })
+                .collect::<Vec<_>>(),
+        );
+    }
+    let mut out = empty();
+    for part in parts {
+        for (t, p) in out.iter_mut().zip(part) {
+            t.merge(p);
+        }
+    }
+    out
+}
+
+/// Number of configurations in the adversarial grid.
+pub fn adversarial_len() -> u64 {
+    adversarial_cases().len() as u64
+}
