@@ -5,4 +5,5 @@ mod config;
 mod determinism;
 mod exact;
 mod mountain_car;
+mod safety;
 mod sampled;
