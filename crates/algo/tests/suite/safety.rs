@@ -25,6 +25,7 @@
 //!
 //! Cost: 14 runs of 200 iterations (7 exact, 7 sampled with N = 100) plus three J-only DP
 //! evaluations per iteration, about 25 s of CPU in total.
+use approx::abs_diff_eq;
 use rayon::prelude::*;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::record::Record;
@@ -234,7 +235,7 @@ fn exact_runs_realise_every_logged_guarantee() {
         );
         for (r, b) in records.iter().zip(&judged.budget) {
             assert!(
-                (r.budget - b).abs() <= slack(*b) + slack(r.j_exploratory),
+                abs_diff_eq!(r.budget, *b, epsilon = slack(*b) + slack(r.j_exploratory)),
                 "{alg:?}: logged budget {} but Definition 4.3 gives {b} at iteration {}",
                 r.budget,
                 r.iteration
