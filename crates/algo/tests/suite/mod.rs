@@ -6,4 +6,6 @@ mod config;
 mod determinism;
 mod exact;
 mod mountain_car;
+mod plumbing;
+mod safety;
 mod sampled;

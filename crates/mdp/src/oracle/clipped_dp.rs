@@ -74,8 +74,12 @@ const MAX_PIECES: usize = 1_000_000;
 /// `∂_v J`, `∂_w J`, `∂²_{wv} J` within `2e-8 · max(|J|, 1)` of a much finer reference (16
 /// nodes, 2 to 6 times narrower elements), and within `1e-9 · max(|J|, 1)` for
 /// `σ ∈ [10⁻³, 0.02]`; `tests/oracle_dp.rs` checks `1e-9` and `1e-7` on its
-/// convergence-study cases. The error shrinks by about two orders of magnitude per two extra
-/// nodes per element. Smaller `σ` stays finite and tends to the deterministic policy, or
+/// convergence-study cases. Over `v ∈ [−1.8, 0.3]`, `σ ∈ [0.1, 1.5]`, `H ∈ [1, 24]` (250
+/// random points of both presets) the worst errors measured against the same reference are
+/// `1.6e-10` (`J`), `2.1e-9` (`∂_v J`, `∂_w J`), `1.6e-8` (`∂²_{wv} J`) and `3.3e-8` (the
+/// Hessian), all relative to `max(|J|, 1)`; the tests hold the derivatives to `2e-8` (first
+/// and mixed) and `5e-8` (Hessian). The error shrinks by about two orders of magnitude per
+/// two extra nodes per element. Smaller `σ` stays finite and tends to the deterministic policy, or
 /// fails with [`OracleError::ResolutionExceeded`] when the features of an expanding closed
 /// loop (`|A + Bv| > 1`) need more than `max_elements` elements.
 ///
