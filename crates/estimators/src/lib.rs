@@ -28,6 +28,7 @@
 
 #![deny(missing_docs)]
 
+pub mod binomial;
 pub mod confidence;
 pub mod error;
 pub mod estimate;
