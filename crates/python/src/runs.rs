@@ -315,6 +315,24 @@ fn read_sweep_file(path: PathBuf) -> PyResult<String> {
     json(&sweep::read_spec(&path).map_err(invalid)?)
 }
 
+/// Runs the numerical checks of the thesis's statements (`sepg-verification`, as
+/// `sepg verify`): all, or those whose identifier contains `check`; `quick` runs the CI
+/// subset. Returns the report as JSON text (each check's outcome and whether it is the
+/// recorded one).
+#[pyfunction]
+#[pyo3(signature = (quick = true, check = None, seed = 0))]
+fn verify(py: Python<'_>, quick: bool, check: Option<&str>, seed: u64) -> PyResult<String> {
+    let checks = sepg_verification::registry();
+    if let Some(f) = check
+        && !checks.iter().any(|c| c.meta.id.contains(f))
+    {
+        return Err(invalid(format!("no check matches {f:?}")));
+    }
+    let config = sepg_verification::RunConfig { seed, quick };
+    let report = py.detach(|| sepg_verification::run_checks(&checks, &config, check, |_| {}));
+    report.to_json().map_err(failed)
+}
+
 /// Adds the functions of this module to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_folder, m)?)?;
@@ -326,5 +344,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(merge_folders, m)?)?;
     m.add_function(wrap_pyfunction!(audit_folder, m)?)?;
     m.add_function(wrap_pyfunction!(read_sweep_file, m)?)?;
+    m.add_function(wrap_pyfunction!(verify, m)?)?;
     Ok(())
 }
