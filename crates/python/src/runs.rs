@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
@@ -18,17 +19,23 @@ use sepg_runs::sweep::{self, Shard, SweepFile, SweepOptions, SweepSpec};
 use crate::{failed, invalid};
 
 /// Raises the stop flag of a run when Python has a pending signal (Ctrl-C), keeping the
-/// exception to re-raise it once the run has checkpointed.
+/// exception to re-raise it once the run has checkpointed. Signals are looked at every
+/// [`SIGNAL_PERIOD`] at most, so that the run does not take the GIL at every iteration.
 struct SignalWatch {
     stop: AtomicBool,
     error: Mutex<Option<PyErr>>,
+    last: Mutex<Instant>,
 }
+
+/// The longest time between two looks at Python's pending signals.
+const SIGNAL_PERIOD: Duration = Duration::from_millis(100);
 
 impl SignalWatch {
     fn new() -> Self {
         SignalWatch {
             stop: AtomicBool::new(false),
             error: Mutex::new(None),
+            last: Mutex::new(Instant::now()),
         }
     }
 
@@ -48,6 +55,10 @@ impl SignalWatch {
 
 impl Observer for SignalWatch {
     fn advance(&self, _done: u64) {
+        match self.last.lock() {
+            Ok(mut last) if last.elapsed() >= SIGNAL_PERIOD => *last = Instant::now(),
+            _ => return,
+        }
         Python::attach(|py| {
             if let Err(e) = py.check_signals() {
                 if let Ok(mut slot) = self.error.lock() {

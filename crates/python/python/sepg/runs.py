@@ -17,8 +17,6 @@ import json
 import os
 from typing import Any, Dict, List, Optional, Sequence, Union
 
-import numpy as np
-
 from sepg import _native
 from sepg.errors import InvalidInputError
 
@@ -76,13 +74,15 @@ class RunFolder:
     ``summary`` (``None`` while incomplete) and ``complete``."""
 
     def __init__(self, dir: PathLike) -> None:
+        import numpy as np
+
         config, columns, rows, summary = _native.read_folder(os.fspath(dir))
         self.dir = os.fspath(dir)
         self.config: Dict[str, Any] = json.loads(config)
         self.summary: Optional[Dict[str, Any]] = None if summary is None else json.loads(summary)
         self.complete = self.summary is not None
         self.columns: List[str] = list(columns)
-        self.log: Dict[str, np.ndarray] = {}
+        self.log: Dict[str, Any] = {}
         for j, name in enumerate(columns):
             values = [row[j] for row in rows]
             if any(v is None for v in values):
