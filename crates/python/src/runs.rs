@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
@@ -18,17 +19,23 @@ use sepg_runs::sweep::{self, Shard, SweepFile, SweepOptions, SweepSpec};
 use crate::{failed, invalid};
 
 /// Raises the stop flag of a run when Python has a pending signal (Ctrl-C), keeping the
-/// exception to re-raise it once the run has checkpointed.
+/// exception to re-raise it once the run has checkpointed. Signals are looked at every
+/// [`SIGNAL_PERIOD`] at most, so that the run does not take the GIL at every iteration.
 struct SignalWatch {
     stop: AtomicBool,
     error: Mutex<Option<PyErr>>,
+    last: Mutex<Instant>,
 }
+
+/// The longest time between two looks at Python's pending signals.
+const SIGNAL_PERIOD: Duration = Duration::from_millis(100);
 
 impl SignalWatch {
     fn new() -> Self {
         SignalWatch {
             stop: AtomicBool::new(false),
             error: Mutex::new(None),
+            last: Mutex::new(Instant::now()),
         }
     }
 
@@ -48,6 +55,10 @@ impl SignalWatch {
 
 impl Observer for SignalWatch {
     fn advance(&self, _done: u64) {
+        match self.last.lock() {
+            Ok(mut last) if last.elapsed() >= SIGNAL_PERIOD => *last = Instant::now(),
+            _ => return,
+        }
         Python::attach(|py| {
             if let Err(e) = py.check_signals() {
                 if let Ok(mut slot) = self.error.lock() {
@@ -315,6 +326,24 @@ fn read_sweep_file(path: PathBuf) -> PyResult<String> {
     json(&sweep::read_spec(&path).map_err(invalid)?)
 }
 
+/// Runs the numerical checks of the thesis's statements (`sepg-verification`, as
+/// `sepg verify`): all, or those whose identifier contains `check`; `quick` runs the CI
+/// subset. Returns the report as JSON text (each check's outcome and whether it is the
+/// recorded one).
+#[pyfunction]
+#[pyo3(signature = (quick = true, check = None, seed = 0))]
+fn verify(py: Python<'_>, quick: bool, check: Option<&str>, seed: u64) -> PyResult<String> {
+    let checks = sepg_verification::registry();
+    if let Some(f) = check
+        && !checks.iter().any(|c| c.meta.id.contains(f))
+    {
+        return Err(invalid(format!("no check matches {f:?}")));
+    }
+    let config = sepg_verification::RunConfig { seed, quick };
+    let report = py.detach(|| sepg_verification::run_checks(&checks, &config, check, |_| {}));
+    report.to_json().map_err(failed)
+}
+
 /// Adds the functions of this module to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_folder, m)?)?;
@@ -326,5 +355,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(merge_folders, m)?)?;
     m.add_function(wrap_pyfunction!(audit_folder, m)?)?;
     m.add_function(wrap_pyfunction!(read_sweep_file, m)?)?;
+    m.add_function(wrap_pyfunction!(verify, m)?)?;
     Ok(())
 }

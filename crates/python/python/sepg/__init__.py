@@ -12,12 +12,12 @@
   built-in environments, as the command line writes them.
 
 Errors are the classes of :mod:`sepg.errors`; bad input raises
-:class:`~sepg.errors.InvalidInputError`, a ``ValueError``.
+:class:`~sepg.errors.InvalidInputError`, a ``ValueError``. numpy is imported when first
+needed, so that ``import sepg`` stays cheap for runs of the built-in environments.
 """
 
+import math
 from typing import Any, Dict, List, Optional, Sequence, Tuple
-
-import numpy as np
 
 from sepg import bounds, errors, runs
 from sepg._native import (
@@ -63,7 +63,7 @@ def required_improvement(
         raise InvalidInputError(
             f"unknown requirement {requirement!r}: expected one of {', '.join(_REQUIREMENTS)}"
         )
-    if not np.isfinite(budget) or budget < 0.0:
+    if not math.isfinite(budget) or budget < 0.0:
         raise InvalidInputError(f"budget = {budget} must be finite and non-negative")
     if requirement == "mi":
         return bounds.budget_split_requirement(0.0, 0.0)
@@ -77,14 +77,16 @@ def required_improvement(
     return -budget, -budget
 
 
-def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, np.ndarray]:
+def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, Any]:
     """Per-iteration records (dicts with the fields of the run log) as one numpy array per
     field: floats, integers and booleans as typed arrays, vectors as 2-D arrays (one row
     per iteration), and fields that are sometimes absent as object arrays holding ``None``
     where absent (never NaN)."""
+    import numpy as np
+
     if not records:
         return {}
-    out: Dict[str, np.ndarray] = {}
+    out: Dict[str, Any] = {}
     for key in records[0]:
         values = [r[key] for r in records]
         if any(v is None for v in values):
@@ -106,6 +108,7 @@ def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, np.ndarray
 def records_to_pandas(records: Sequence[Dict[str, Any]]) -> Any:
     """The records as a pandas DataFrame (needs pandas): vectors are split into one column
     per component (``v_0``, ``v_1``, ...), absent values are ``pd.NA`` in nullable columns."""
+    import numpy as np
     import pandas as pd
 
     columns: Dict[str, Any] = {}

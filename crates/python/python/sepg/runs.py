@@ -4,6 +4,9 @@ Python, through the library behind ``sepg run``, ``sepg sweep``, ``sepg merge`` 
 ``sepg run`` with ``_`` for ``-``: ``env``, ``algo``, ``iterations``, ``batch``, ``horizon``,
 ``seed``, ``sigma0``, ``v0``, ``delta``, ``nu``, ``gradients``, ``lr``, ``lr_w``, ...).
 
+:func:`exact`, :func:`estimate` and :func:`verify` are ``sepg exact``, ``sepg estimate`` and
+``sepg verify``.
+
 A sweep maps its runs over Dask or Ray when asked (``engine="dask"``/``"ray"``) or, with
 ``engine="auto"``, when Ray is initialised or Dask is installed. Every run is the same
 deterministic unit wherever it runs, so the folder is byte-identical to a sweep run on one
@@ -13,8 +16,6 @@ machine (wall-clock figures in ``summary.json`` aside).
 import json
 import os
 from typing import Any, Dict, List, Optional, Sequence, Union
-
-import numpy as np
 
 from sepg import _native
 from sepg.errors import InvalidInputError
@@ -73,13 +74,15 @@ class RunFolder:
     ``summary`` (``None`` while incomplete) and ``complete``."""
 
     def __init__(self, dir: PathLike) -> None:
+        import numpy as np
+
         config, columns, rows, summary = _native.read_folder(os.fspath(dir))
         self.dir = os.fspath(dir)
         self.config: Dict[str, Any] = json.loads(config)
         self.summary: Optional[Dict[str, Any]] = None if summary is None else json.loads(summary)
         self.complete = self.summary is not None
         self.columns: List[str] = list(columns)
-        self.log: Dict[str, np.ndarray] = {}
+        self.log: Dict[str, Any] = {}
         for j, name in enumerate(columns):
             values = [row[j] for row in rows]
             if any(v is None for v in values):
@@ -180,4 +183,15 @@ def audit(dir: PathLike, *, tolerance: float = 1e-9) -> Dict[str, Any]:
     return json.loads(_native.audit_folder(os.fspath(dir), tolerance))
 
 
-__all__ = ["RunFolder", "audit", "merge", "read_run", "resume", "run", "sweep"]
+def verify(*, quick: bool = True, check: Optional[str] = None, seed: int = 0) -> Dict[str, Any]:
+    """Runs the numerical checks of the thesis's statements, as ``sepg verify``: every check,
+    or those whose identifier contains ``check``; ``quick`` is the CI subset. Returns the
+    report; ``report["results"][i]["as_expected"]`` says whether each outcome is the one
+    recorded."""
+    return json.loads(_native.verify(quick, check, seed))
+
+
+exact = _native.exact
+estimate = _native.estimate
+
+__all__ = ["RunFolder", "audit", "estimate", "exact", "merge", "read_run", "resume", "run", "sweep", "verify"]
