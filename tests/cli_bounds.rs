@@ -222,3 +222,45 @@ fn bad_input_is_one_line_and_exit_2() {
         "the message names the parameter: {line}"
     );
 }
+
+#[test]
+fn certified_prints_enclosures_around_the_f64_values() {
+    let v = run_json(&[
+        "--grad-v",
+        "0.8,-1.5",
+        "--grad-w",
+        "0.05",
+        "--grad-w-l",
+        "-0.3",
+        "--required",
+        "-1e-9",
+        "--certified",
+    ]);
+    let cert = &v["certified"];
+    let enclosure = |name: &str| {
+        let e = &cert["enclosures"][name];
+        let (lo, hi) = (e[0].as_f64().expect("lo"), e[1].as_f64().expect("hi"));
+        assert!(lo <= hi, "{name}: [{lo}, {hi}]");
+        (lo, hi)
+    };
+    // the f64 values lie in (or within rounding of) their enclosures, which are ulps wide
+    let (c, d) = c_and_d(0.99, 4.0, 2.0, 4.0, 0.5);
+    for (name, value) in [
+        ("c", c),
+        ("d", d),
+        ("c_max_v", get(&v, "c_max_v")),
+        ("alpha_hi", get(&v, "alpha_bar")),
+    ] {
+        let (lo, hi) = enclosure(name);
+        assert!(close(lo, value, 1e-14) && close(hi, value, 1e-14), "{name}");
+    }
+    let (lo, hi) = enclosure("psi");
+    assert!(lo < 0.523_557_020_321_373_7 && 0.523_557_020_321_373_7 <= hi);
+    // the certified largest step guarantees C: its bound's lower end is at least C
+    let step = &cert["steps"]["alpha_bar"];
+    assert_eq!(step["outcome"], "certified");
+    assert!(step["bound"][0].as_f64().expect("bound") >= -1e-9);
+    assert!(step["step"].as_f64().expect("step") <= get(&v, "alpha_bar"));
+    // without the flag there is no certified section
+    assert!(run_json(&[]).get("certified").is_none());
+}

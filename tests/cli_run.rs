@@ -98,6 +98,8 @@ fn the_issue_form_writes_a_complete_run_folder() {
         "lambda_w",
         "guaranteed_v",
         "guaranteed_w",
+        "certified_v",
+        "certified_w",
     ] {
         assert!(
             header.contains(&col),

@@ -1,8 +1,12 @@
 //! `sepg bounds`: every closed-form quantity that the given task constants, σ and gradients
 //! determine (Theorems 3.11, 3.13, 3.14, 4.2, 4.3, 4.5, Lemma A.1, Corollary 4.4).
 
+use std::collections::BTreeMap;
+
 use clap::Args;
+use sepg_bounds::certified::{self, Certified, Quadratic};
 use sepg_bounds::constants::{self, TaskConstants};
+use sepg_bounds::interval::Interval;
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
 use serde::Serialize;
@@ -60,6 +64,101 @@ pub struct BoundsArgs {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     json: bool,
+    /// Also print, under `certified`, an outward-rounded enclosure [lo, hi] of ψ, c, d, C_max,
+    /// λ and every safe-interval end point, and the certified largest steps with the
+    /// enclosure of their bound (docs/THEOREMS.md, Certified steps).
+    #[arg(long)]
+    certified: bool,
+}
+
+/// Enclosures and certified steps of `sepg bounds --certified`.
+#[derive(Debug, Default, Serialize)]
+struct CertifiedReport {
+    /// Name → [lo, hi] enclosing the exact real value.
+    enclosures: BTreeMap<&'static str, [f64; 2]>,
+    /// Largest step → its certified outcome.
+    steps: BTreeMap<&'static str, CertifiedStepReport>,
+}
+
+/// One certified step: `certified`, `uncertifiable`, `infeasible` or `no-step`; the step
+/// taken and the enclosure of its bound.
+#[derive(Debug, Serialize)]
+struct CertifiedStepReport {
+    outcome: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    step: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bound: Option<[f64; 2]>,
+}
+
+fn ends(i: Interval) -> [f64; 2] {
+    [i.lo(), i.hi()]
+}
+
+fn step_report(c: &Certified) -> CertifiedStepReport {
+    let outcome = match c {
+        Certified::Step(_) => "certified",
+        Certified::Uncertifiable { .. } => "uncertifiable",
+        Certified::Infeasible { .. } => "infeasible",
+        _ => "no-step",
+    };
+    CertifiedStepReport {
+        outcome,
+        step: c.chosen_step(),
+        bound: c.bound().map(ends),
+    }
+}
+
+/// Enclosures of a quadratic bound's C_max, λ and end points for the requirement C.
+fn quadratic_enclosures(
+    out: &mut BTreeMap<&'static str, [f64; 2]>,
+    q: &Quadratic,
+    required: f64,
+    names: [&'static str; 4],
+) {
+    let [c_max, lambda, lo, hi] = names;
+    out.insert(c_max, ends(q.c_max()));
+    if let Some((l, h)) = q.end_points(required) {
+        out.insert(lambda, ends(q.lambda(required)));
+        out.insert(lo, ends(l));
+        out.insert(hi, ends(h));
+    }
+}
+
+fn compute_certified(
+    a: &BoundsArgs,
+    k: &TaskConstants,
+    (required_v, required_w): (f64, f64),
+) -> Result<CertifiedReport, CliError> {
+    let sigma = a.sigma;
+    let mut r = CertifiedReport::default();
+    r.enclosures.insert("psi", ends(certified::psi()));
+    r.enclosures
+        .insert("c", ends(certified::c(k, sigma).map_err(bad)?));
+    r.enclosures
+        .insert("d", ends(certified::d(k, sigma).map_err(bad)?));
+    if let Some(g) = &a.grad_v {
+        let q = Quadratic::v_update(k, sigma, g).map_err(bad)?;
+        let names = ["c_max_v", "lambda_v", "alpha_lo", "alpha_hi"];
+        quadratic_enclosures(&mut r.enclosures, &q, required_v, names);
+        let o = certified::v_safe_step(k, sigma, g, required_v).map_err(bad)?;
+        r.steps.insert("alpha_bar", step_report(&o));
+    }
+    if let Some(gj) = a.grad_w {
+        let q = Quadratic::w_along_j(k, sigma, gj).map_err(bad)?;
+        let names = ["c_max_w", "lambda_w", "beta_lo_j", "beta_hi_j"];
+        quadratic_enclosures(&mut r.enclosures, &q, required_w, names);
+        let o = certified::w_safe_step_along_j(k, sigma, gj, required_w).map_err(bad)?;
+        r.steps.insert("beta_bar_j", step_report(&o));
+        if let Some(gl) = a.grad_w_l {
+            let q = Quadratic::w_along_l(k, sigma, gj, gl).map_err(bad)?;
+            let names = ["c_max_w_l", "lambda_w_l", "beta_lo", "beta_hi"];
+            quadratic_enclosures(&mut r.enclosures, &q, required_w, names);
+            let o = certified::w_safe_step_along_l(k, sigma, gj, gl, required_w).map_err(bad)?;
+            r.steps.insert("beta_bar", step_report(&o));
+        }
+    }
+    Ok(r)
 }
 
 /// Everything `sepg bounds` reports. Optional fields are absent when the inputs do not
@@ -114,6 +213,8 @@ struct BoundsReport {
     batch_reinforce: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     batch_gpomdp: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    certified: Option<CertifiedReport>,
 }
 
 fn bad(e: BoundsError) -> CliError {
@@ -221,6 +322,9 @@ fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
             ));
         }
     }
+    if a.certified {
+        r.certified = Some(compute_certified(a, &k, (required_v, required_w))?);
+    }
     Ok(r)
 }
 
@@ -309,6 +413,23 @@ fn render_table(r: &BoundsReport) -> String {
     let mut out = String::new();
     for (name, value, cite) in rows {
         out.push_str(&format!("{name:<22} {value:>16}   {cite}\n"));
+    }
+    if let Some(c) = &r.certified {
+        out.push_str("certified enclosures [lo, hi] (outward-rounded):\n");
+        for (name, [lo, hi]) in &c.enclosures {
+            out.push_str(&format!("  {name:<20} [{lo:e}, {hi:e}]\n"));
+        }
+        out.push_str("certified steps:\n");
+        for (name, s) in &c.steps {
+            let step = s.step.map_or_else(|| "-".to_string(), |x| format!("{x:e}"));
+            let bound = s
+                .bound
+                .map_or_else(|| "-".to_string(), |[lo, hi]| format!("[{lo:e}, {hi:e}]"));
+            out.push_str(&format!(
+                "  {name:<20} {:<14} step {step}, bound {bound}\n",
+                s.outcome
+            ));
+        }
     }
     out
 }

@@ -95,7 +95,10 @@ fn indexed(name: &str, dim: usize) -> Vec<String> {
 /// Columns: `iteration`, `v` (or `v_0, v_1, …`), `w`, `sigma`, `j_explore`, `j_after_v`,
 /// `j_target`, `w_target`, `budget`, `required`, `required_w`, `alpha`, `beta`, `lambda_v`,
 /// `lambda_w`, `guaranteed_v`, `guaranteed_w`, `infeasible`, `infeasible_v`, `infeasible_w`,
-/// `below_noise_v`, `below_noise_w`, `trajectories`, `steps`.
+/// `below_noise_v`, `below_noise_w`, `trajectories`, `steps`, `certified_v`, `certified_w`
+/// (1 when the step's bound was certified in interval arithmetic to meet its requirement, 0
+/// when it was not — infeasible or within rounding of C_max —, empty when certification is
+/// off or no step was taken; see `sepg_algo::core::record::Record::certified_v`).
 pub fn log_header(dim_v: usize, dim_w: usize) -> String {
     let mut cols = vec!["iteration".to_owned()];
     cols.extend(indexed("v", dim_v));
@@ -121,6 +124,8 @@ pub fn log_header(dim_v: usize, dim_w: usize) -> String {
             "below_noise_w",
             "trajectories",
             "steps",
+            "certified_v",
+            "certified_w",
         ]
         .map(String::from),
     );
@@ -167,6 +172,8 @@ pub fn log_row(r: &Record) -> String {
         b(r.below_noise_w),
         r.trajectories.to_string(),
         r.steps.to_string(),
+        r.certified_v.map(b).unwrap_or_default(),
+        r.certified_w.map(b).unwrap_or_default(),
     ]);
     let mut s = cells.join(",");
     s.push('\n');

@@ -2,7 +2,7 @@
 //!
 //! For every input configuration and every bound form, the largest safe step computed in
 //! `f64` (uncertified) and the certified step are evaluated in multiple-precision interval
-//! arithmetic ([`mp`]), with the `f64` inputs and the step taken as exact dyadic rationals and
+//! arithmetic (module `mp`), with the `f64` inputs and the step taken as exact dyadic rationals and
 //! every irrational constant (π, √7, e^x, hence √(2π) and ψ) enclosed by series with rigorous
 //! remainders. The bound formulas here are written from the thesis, independently of
 //! `sepg-bounds`. A step *violates* its requirement C when the enclosure of B(step) lies
