@@ -20,6 +20,20 @@ use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rollout::rollout;
 
 use crate::suite::common::run;
+use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::solver::PolicySolver;
+
+/// The first record of a run of `cfg`, with certified steps (the default) or the f64 steps.
+fn first_record(cfg: SepgConfig, certified: bool) -> Record {
+    let checked = cfg.check().expect("valid").with_certified_steps(certified);
+    let mut log = Collect::default();
+    let solver = PolicySolver::new(&checked).expect("solver");
+    Executor::new(solver, checked.initial_state())
+        .observe(&mut log)
+        .run(1)
+        .expect("run");
+    log.records.remove(0)
+}
 
 const TABLE: &str = include_str!("../../../estimators/tests/data/t_quantiles.csv");
 
@@ -86,17 +100,19 @@ fn assert_guarantee(logged: Option<f64>, bound: Option<HighProbabilityBound>, st
 }
 
 /// The first sampled iteration of LB-II (B⁰ = 0.05, two blocks of 50 trajectories, δ = 0.2)
-/// and of its naive-w variant, for several seeds, recomputed from the batches.
+/// and of its naive-w variant, for several seeds, with certified and with f64 steps,
+/// recomputed from the batches.
 #[test]
 fn one_sampled_iteration_recomputed_from_its_batches() {
     let delta = 0.2;
     let b0 = 0.05;
     let env = LqgEnv::thesis();
     let mut w_updates = [0, 0];
-    for (naive, seed) in [false, true]
+    let cases = [false, true]
         .into_iter()
         .flat_map(|n| (0..6).map(move |s| (n, s)))
-    {
+        .flat_map(|(n, s)| [true, false].map(|c| (n, s, c)));
+    for (naive, seed, certified) in cases {
         let alg = if naive {
             Algorithm::SepgNaiveW(Requirement::LbII)
         } else {
@@ -111,8 +127,7 @@ fn one_sampled_iteration_recomputed_from_its_batches() {
         };
         let checked = cfg.clone().check().expect("valid");
         let k: TaskConstants = *checked.constants();
-        let (records, _) = run(cfg.clone(), 1);
-        let r = &records[0];
+        let r = &first_record(cfg.clone(), certified);
         let (v0, w0, sigma) = (cfg.v0.clone(), vec![0.5f64.ln()], 0.5);
         let features = env.feature_dim();
         let spec = GradientSpec::default();
@@ -271,5 +286,72 @@ fn logged_requirements_follow_from_the_logged_j() {
                 );
             }
         }
+    }
+}
+
+/// The first exact iteration of LB-II (B⁰ = 0.05) and of its naive-w variant, recomputed
+/// through `sepg_bounds` from the clipped-LQG oracle's J and derivatives (Theorems 4.2, 4.3,
+/// 4.5; ∇_w L of Corollary 4.4 by eq. B.1), with certified and with f64 steps.
+#[test]
+fn one_exact_iteration_recomputed_from_the_oracle() {
+    use sepg_bounds::{surrogate, v_update, w_update};
+    use sepg_mdp::oracle::{ClippedDpOracle, ExactOracle, Exploration, Horizon, Needs};
+    let b0 = 0.05;
+    let env = LqgEnv::thesis();
+    let oracle = ClippedDpOracle::new(env.model()).expect("clipped preset");
+    let cases = [(false, 0.5), (true, 0.5), (false, 0.2), (true, 1.0)];
+    for ((naive, sigma), certified) in cases.into_iter().flat_map(|c| [(c, true), (c, false)]) {
+        let alg = if naive {
+            Algorithm::SepgNaiveW(Requirement::LbII)
+        } else {
+            Algorithm::Sepg(Requirement::LbII)
+        };
+        let cfg = SepgConfig {
+            gradient: GradientMode::Exact,
+            sigma0: vec![sigma],
+            initial_budget: b0,
+            ..SepgConfig::new(AnyEnv::Lqg(Box::new(env.clone())), alg)
+        };
+        let k: TaskConstants = *cfg.clone().check().expect("valid").constants();
+        let r = &first_record(cfg.clone(), certified);
+        let at = |v: f64| {
+            let ex = Exploration::Gaussian {
+                w: vec![sigma.ln()],
+            };
+            oracle
+                .evaluate_with(&[v], &ex, Horizon::Finite(20), Needs::SEPG)
+                .expect("oracle")
+        };
+        let e0 = at(cfg.v0[0]);
+        let alpha = step_of(v_update::safe_step(&k, sigma, &e0.grad_v, -b0).expect("v step"));
+        assert_relative_eq!(r.alpha, alpha, max_relative = 1e-12);
+        assert_relative_eq!(
+            r.guaranteed_v.expect("v updated"),
+            v_update::bound(&k, sigma, &e0.grad_v, alpha).expect("bound"),
+            max_relative = 1e-12
+        );
+        let e1 = at(cfg.v0[0] + alpha * e0.grad_v[0]);
+        let required_w = -(b0 + e1.j - e0.j);
+        let gj = e1.grad_w[0];
+        let (beta, guaranteed) = if naive {
+            let s = step_of(w_update::safe_step_along_j(&k, sigma, gj, required_w).expect("step"));
+            (s, w_update::bound_along_j(&k, sigma, gj, s).expect("bound"))
+        } else {
+            let mixed_sigma = [e1.mixed_wv[0] / sigma];
+            let gl = surrogate::grad_w(&k, sigma, &e1.grad_v, &mixed_sigma).expect("grad L");
+            let s =
+                step_of(w_update::safe_step_along_l(&k, sigma, gj, gl, required_w).expect("step"));
+            (
+                s,
+                w_update::bound_along_l(&k, sigma, gj, gl, s).expect("bound"),
+            )
+        };
+        assert_relative_eq!(r.required_w.expect("C_w"), required_w, max_relative = 1e-12);
+        assert_relative_eq!(r.beta, beta, max_relative = 1e-12);
+        assert_relative_eq!(
+            r.guaranteed_w.expect("w updated"),
+            guaranteed,
+            max_relative = 1e-12
+        );
     }
 }
