@@ -32,7 +32,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
     /// Iterations between checkpoints (rows are appended to the log at each checkpoint).
-    #[arg(long = "checkpoint-every", value_name = "K", default_value_t = 500)]
+    #[arg(
+        long = "checkpoint-every",
+        value_name = "K",
+        default_value_t = 500,
+        allow_negative_numbers = true
+    )]
     checkpoint_every: u64,
 }
 
