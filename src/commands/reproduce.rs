@@ -83,7 +83,15 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
         observer: &bar,
     };
     progress::install_interrupt_handler();
-    let (file, stats) = reproduce::run(&opts, &dir, mode, sweep_opts)?;
+    let (file, stats) =
+        reproduce::run(&opts, &dir, mode, sweep_opts).map_err(|e| match e {
+            sepg_runs::Error::SweepInterrupted { complete, runs, .. } => CliError::failure(format!(
+                "interrupted with {complete} of {runs} runs complete; resume with: sepg reproduce {} --resume --out {} (and the same options)",
+                args.what.name(),
+                dir.display()
+            )),
+            e => e.into(),
+        })?;
     if !args.quiet {
         eprintln!("{}", stats_line(&dir, &file, &stats));
     }

@@ -83,6 +83,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
                 "--resume takes no other options than --quiet and --checkpoint-every",
             ));
         }
+        if folder::is_complete(dir) {
+            let s = folder::read_summary(dir)?;
+            if !args.quiet {
+                println!(
+                    "{}: already complete ({} iterations); nothing to resume",
+                    dir.display(),
+                    s.iterations
+                );
+            }
+            return Ok(());
+        }
         (dir.clone(), run::resume(dir, opts)?)
     } else {
         let file = match &args.config {
