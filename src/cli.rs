@@ -99,6 +99,58 @@ enum Command {
     Audit(commands::audit::AuditArgs),
 }
 
+/// One line for a command-line parsing error that keeps the parser's detail: the missing
+/// flags, the rejected value with the valid values, or the reason a value was refused.
+fn parse_error_line(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let strings = |kind: ContextKind| -> Vec<String> {
+        match e.get(kind) {
+            Some(ContextValue::String(s)) => vec![s.clone()],
+            Some(ContextValue::Strings(v)) => v.clone(),
+            _ => Vec::new(),
+        }
+    };
+    let invalid = strings(ContextKind::InvalidArg).join(", ");
+    match e.kind() {
+        ErrorKind::MissingRequiredArgument if !invalid.is_empty() => {
+            format!("missing required arguments: {invalid}")
+        }
+        ErrorKind::InvalidValue if !invalid.is_empty() => {
+            let value = strings(ContextKind::InvalidValue).join(", ");
+            let mut line = if value.is_empty() {
+                format!("{invalid} needs a value")
+            } else {
+                format!("invalid value '{value}' for {invalid}")
+            };
+            let valid = strings(ContextKind::ValidValue);
+            if !valid.is_empty() {
+                line.push_str(&format!("; valid values: {}", valid.join(", ")));
+            }
+            line
+        }
+        _ => {
+            // Every other kind: the rendered message without the usage and help footer, its
+            // lines (the error, then any tip) joined into one.
+            let text = e.render().to_string();
+            let parts: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .filter(|l| {
+                    !l.is_empty()
+                        && !l.starts_with("Usage:")
+                        && !l.starts_with("For more information")
+                })
+                .map(|l| l.trim_start_matches("error: "))
+                .collect();
+            if parts.is_empty() {
+                "invalid arguments".to_owned()
+            } else {
+                parts.join("; ")
+            }
+        }
+    }
+}
+
 /// Parses the command line, runs the command and maps failures to exit statuses.
 pub fn run() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -117,10 +169,7 @@ pub fn run() -> ExitCode {
                     }
                 }
                 _ => {
-                    let text = e.to_string();
-                    let first = text.lines().next().unwrap_or("invalid arguments");
-                    let first = first.trim_start_matches("error: ");
-                    eprintln!("sepg: error: {first}");
+                    eprintln!("sepg: error: {}", parse_error_line(&e));
                     ExitCode::from(EXIT_USAGE)
                 }
             };

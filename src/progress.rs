@@ -8,14 +8,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use indicatif::{ProgressBar, ProgressStyle};
 use sepg_runs::run::Observer;
 
-/// Raised by SIGINT: every running loop stops after its current iteration and checkpoints.
+/// Raised by SIGINT or SIGTERM (what cluster schedulers send before killing a job): every
+/// running loop stops after its current iteration and checkpoints.
 pub static STOP: AtomicBool = AtomicBool::new(false);
 
-/// Installs the SIGINT handler that raises [`STOP`] (once per process).
+/// Installs the SIGINT and SIGTERM handler that raises [`STOP`] (once per process).
 pub fn install_interrupt_handler() {
     static ONCE: OnceLock<()> = OnceLock::new();
     ONCE.get_or_init(|| {
-        // Without a handler (e.g. one is already installed) Ctrl-C keeps its default
+        // Without a handler (e.g. one is already installed) the signals keep their default
         // action; the checkpoints still leave the folder consistent.
         let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::SeqCst));
     });

@@ -188,7 +188,10 @@ fn a_clean_exact_run_passes_and_an_injected_drop_is_reported_at_its_iteration() 
         );
     }
     let mi = check(&report, "mi");
-    assert_eq!((mi["checked"].as_u64(), mi["failed"].as_u64()), (Some(12), Some(1)));
+    assert_eq!(
+        (mi["checked"].as_u64(), mi["failed"].as_u64()),
+        (Some(12), Some(1))
+    );
     assert_eq!(mi["worst_iteration"], 5);
 
     // The table lists every check, names the iteration, and the exit status says so.
@@ -204,7 +207,10 @@ fn a_clean_exact_run_passes_and_an_injected_drop_is_reported_at_its_iteration() 
         "{table}"
     );
     for name in ["guarantee-v", "mi"] {
-        assert!(table.lines().any(|l| l.starts_with(name)), "{name}: {table}");
+        assert!(
+            table.lines().any(|l| l.starts_with(name)),
+            "{name}: {table}"
+        );
     }
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -260,7 +266,10 @@ fn each_exact_check_fails_when_its_own_requirement_is_broken() {
     let b = check(&report, "budget");
     assert_eq!(b["kind"], "bookkeeping");
     assert_eq!(b["verdict"], "note");
-    assert_eq!((b["failed"].as_u64(), b["worst_iteration"].as_u64()), (Some(1), Some(4)));
+    assert_eq!(
+        (b["failed"].as_u64(), b["worst_iteration"].as_u64()),
+        (Some(1), Some(4))
+    );
     let out = sepg(&["audit", path(&zv3)]);
     let table = String::from_utf8(out.stdout).expect("utf-8");
     assert!(table.contains("note: budget failed at 1 of 12"), "{table}");
@@ -379,7 +388,11 @@ fn every_malformed_or_incomplete_folder_exits_with_status_2() {
     assert_malformed(&dir, "without summary.json");
     fs::write(&summary, "{").expect("write");
     assert_malformed(&dir, "summary.json is malformed");
-    fs::write(&summary, s.replace("\"iterations\": 12", "\"iterations\": 11")).expect("write");
+    fs::write(
+        &summary,
+        s.replace("\"iterations\": 12", "\"iterations\": 11"),
+    )
+    .expect("write");
     assert_malformed(&dir, "reports 11 iterations");
     fs::write(&summary, &s).expect("restore");
     assert_eq!(sepg(&["audit", path(&dir)]).status.code(), Some(0));
@@ -411,7 +424,10 @@ fn an_interrupted_run_is_audited_up_to_its_checkpoint_and_reported_incomplete() 
     assert_eq!(out.status.code(), Some(2));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(report["status"], "incomplete");
-    assert_eq!((report["iterations_done"].as_u64(), report["rows"].as_u64()), (Some(8), Some(8)));
+    assert_eq!(
+        (report["iterations_done"].as_u64(), report["rows"].as_u64()),
+        (Some(8), Some(8))
+    );
     assert_eq!(check(&report, "mi")["checked"], 8);
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert!(err.contains("sepg run --resume"), "{err}");
@@ -423,7 +439,11 @@ fn help_documents_the_exit_statuses() {
     let out = sepg(&["audit", "--help"]);
     assert_eq!(out.status.code(), Some(0));
     let help = String::from_utf8(out.stdout).expect("utf-8");
-    for line in ["0  every exact", "1  a check is violated", "2  malformed or incomplete"] {
+    for line in [
+        "0  every exact",
+        "1  a check is violated",
+        "2  malformed or incomplete",
+    ] {
         assert!(help.contains(line), "{line:?} in {help}");
     }
 }

@@ -297,6 +297,18 @@ fn resuming_after_sigkill_at_random_points_is_bit_identical() {
 
 #[test]
 fn sigint_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
+    signal_checkpoints_and_resumes_bit_identically("-INT");
+}
+
+/// SIGTERM, which cluster schedulers send before killing a job, is handled like SIGINT.
+#[test]
+fn sigterm_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
+    signal_checkpoints_and_resumes_bit_identically("-TERM");
+}
+
+/// Sends `signal` (a `kill` flag) to a run a third of the way through; the run must stop at a
+/// checkpoint with one line naming `--resume`, and resume to the uninterrupted result.
+fn signal_checkpoints_and_resumes_bit_identically(signal: &str) {
     let tmp = tempfile::tempdir().expect("tempdir");
     let reference = tmp.path().join("reference");
     let start = Instant::now();
@@ -316,7 +328,7 @@ fn sigint_checkpoints_exits_with_one_line_and_resumes_bit_identically() {
     }
     std::thread::sleep(full / 3);
     let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .expect("kill");
     assert!(status.success());
@@ -456,4 +468,146 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     assert_eq!(forced.status.code(), Some(0));
     assert_eq!(read(&out.join("keep.txt")), "mine");
     assert!(out.join("summary.json").is_file());
+}
+
+/// `sepg run` with `args` under the shell umask `umask`.
+fn run_with_umask(umask: &str, args: &[&str]) -> std::process::Output {
+    let mut cmd = vec![format!("umask {umask}; exec \"$0\" \"$@\"")];
+    cmd.push(env!("CARGO_BIN_EXE_sepg").to_owned());
+    cmd.extend(args.iter().map(|a| (*a).to_owned()));
+    Command::new("sh")
+        .arg("-c")
+        .args(&cmd)
+        .output()
+        .expect("sh")
+}
+
+#[cfg(unix)]
+#[test]
+fn output_files_get_mode_0644_less_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().expect("tempdir");
+    for (umask, file_mode, dir_mode) in [("022", 0o644, 0o755), ("027", 0o640, 0o750)] {
+        let dir = tmp.path().join(format!("run-{umask}"));
+        let d = dir.to_str().expect("utf-8");
+        let run = [
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-mi",
+            "--gradients",
+            "exact",
+            "--iterations",
+            "3",
+            "--quiet",
+            "--out",
+            d,
+        ];
+        let out = run_with_umask(umask, &run);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let out = run_with_umask(umask, &["plot", d, "--quiet"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mode = |p: &Path| std::fs::metadata(p).expect("metadata").permissions().mode() & 0o777;
+        assert_eq!(mode(&dir), dir_mode, "{}", dir.display());
+        let mut seen = 0;
+        for entry in std::fs::read_dir(&dir).expect("read_dir") {
+            let p = entry.expect("entry").path();
+            assert_eq!(mode(&p), file_mode, "{}", p.display());
+            seen += 1;
+        }
+        // config, checkpoint, log, summary, plot.png, plot.svg
+        assert_eq!(seen, 6, "{}", dir.display());
+    }
+}
+
+#[test]
+fn a_diverging_run_keeps_its_rows_and_ends_with_a_clear_error() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("diverging");
+    // A constant w-step of 10 along ∇_w J ≈ −87 sends w beyond the representable range at the
+    // second iteration; the checkpoint period (500) is far away.
+    let out = sepg(&[
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "gpomdp-const",
+        "--alpha",
+        "0.001",
+        "--beta",
+        "10",
+        "--iterations",
+        "200",
+        "--quiet",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("iteration 1 failed") && err.contains("outside the representable range"),
+        "{err}"
+    );
+    assert!(err.contains("kept in log.partial.csv"), "{err}");
+    let log = std::fs::read_to_string(dir.join("log.partial.csv")).expect("log");
+    assert_eq!(
+        log.lines().count(),
+        2,
+        "header and the row of iteration 0: {log}"
+    );
+    assert!(log.lines().nth(1).expect("row").starts_with("0,"));
+    // The checkpoint vouches for exactly those rows.
+    let ck: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("checkpoint.json")).expect("checkpoint"),
+    )
+    .expect("json");
+    assert_eq!(ck["log_bytes"].as_u64(), Some(log.len() as u64));
+    assert_eq!(ck["state"]["iteration"], 1);
+}
+
+#[test]
+fn resuming_a_finished_run_says_so() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("done");
+    let d = dir.to_str().expect("utf-8");
+    let out = sepg(&[
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-mi",
+        "--gradients",
+        "exact",
+        "--iterations",
+        "3",
+        "--quiet",
+        "--out",
+        d,
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let summary = std::fs::read(dir.join("summary.json")).expect("summary");
+    let out = sepg(&["run", "--resume", d]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    assert_eq!(
+        text.trim(),
+        format!("{d}: already complete (3 iterations); nothing to resume")
+    );
+    assert!(!text.contains("it/s"), "{text}");
+    assert_eq!(
+        std::fs::read(dir.join("summary.json")).expect("summary"),
+        summary
+    );
 }

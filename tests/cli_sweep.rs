@@ -247,3 +247,51 @@ fn an_interrupted_sweep_resumes_to_the_same_logs() {
     );
     assert_eq!(logs(&dir), logs(&reference));
 }
+
+#[test]
+fn a_terminated_sweep_names_the_sweep_resume_command() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let cfg = sweep_file(
+        tmp.path(),
+        r#"
+presets = ["lqg1d"]
+seeds = [1, 2]
+sigma0 = [1.0]
+[base]
+iterations = 1000000
+batch = 24
+[[variant]]
+name = "zv"
+algo = "sepg-zv"
+"#,
+    );
+    let dir = tmp.path().join("sweep");
+    let child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(["sweep", "--quiet", "--config"])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // sweep.json is written after the signal handler is installed.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while !dir.join("sweep.json").exists() && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let expected = format!("sepg sweep --resume {}", dir.display());
+    assert!(err.contains(&expected), "{err}");
+    assert!(err.contains("0 of 2 runs complete"), "{err}");
+    assert!(!err.contains("sepg run --resume"), "{err}");
+}

@@ -3,6 +3,7 @@
 mod cli_audit;
 mod cli_bounds;
 mod cli_cluster;
+mod cli_errors;
 mod cli_exact;
 mod cli_reproduce;
 mod cli_run;

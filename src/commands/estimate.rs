@@ -4,15 +4,16 @@
 use std::time::Instant;
 
 use clap::Args;
-use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, Width};
+use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, Width, student_t_quantile};
 use sepg_mdp::env::{Environment, Preset};
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
-use sepg_mdp::rollout::rollout;
+use sepg_mdp::rollout::{rollout, rollout_returns};
 use serde::Serialize;
 
 use crate::cli::CliError;
 use crate::output::to_json_line;
+use sepg_runs::spec::parse_seed;
 
 /// Arguments of `sepg estimate`.
 #[derive(Debug, Args)]
@@ -27,13 +28,13 @@ pub struct EstimateArgs {
     #[arg(long, allow_hyphen_values = true)]
     sigma: f64,
     /// Horizon H ≥ 1 (steps per trajectory).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     horizon: usize,
     /// Number of trajectories N ≥ 2.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     n: usize,
     /// Seed of the batch (trajectory i uses the stream of (seed, 0, 0, i)).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_seed)]
     seed: u64,
     /// Print one JSON object instead of the table.
     #[arg(long)]
@@ -54,13 +55,31 @@ struct EstimateReport {
     n: usize,
     horizon: usize,
     seed: u64,
-    steps: usize,
+    /// Environment steps of the batch (not counted for the deterministic policy, whose
+    /// returns are simulated without scores).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    steps: Option<usize>,
     j: Interval,
     #[serde(skip_serializing_if = "Option::is_none")]
     grad_v: Option<Interval>,
     #[serde(skip_serializing_if = "Option::is_none")]
     grad_w: Option<Interval>,
-    steps_per_sec: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    steps_per_sec: Option<f64>,
+}
+
+/// The mean of the returns `g` with its 95% Student-t interval (Sec 4.5):
+/// ḡ ± t(0.975, n − 1)·√(s²/n), s² the unbiased sample variance.
+fn returns_interval(g: &[f64]) -> Result<Interval, CliError> {
+    let n = g.len() as f64;
+    let mean = g.iter().sum::<f64>() / n;
+    let var = g.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+    let t = student_t_quantile(0.975, n - 1.0).map_err(|e| CliError::failure(e.to_string()))?;
+    let half = t * (var / n).sqrt();
+    Ok(Interval::Scalar {
+        mean,
+        ci95: [mean - half, mean + half],
+    })
 }
 
 fn interval(e: &Estimate) -> Result<Interval, CliError> {
@@ -113,6 +132,22 @@ fn estimate(args: &EstimateArgs) -> Result<EstimateReport, CliError> {
     .map_err(|e| CliError::usage(format!("invalid policy for {}: {e}", args.env)))?;
 
     let key = SeedKey::new(args.seed, 0, 0);
+    if policy.is_deterministic() {
+        // J only: the deterministic policy has no score, so its returns are simulated alone.
+        let g = rollout_returns(&env, &policy, args.n, args.horizon, key)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+        return Ok(EstimateReport {
+            env: args.env.clone(),
+            n: args.n,
+            horizon: args.horizon,
+            seed: args.seed,
+            steps: None,
+            j: returns_interval(&g)?,
+            grad_v: None,
+            grad_w: None,
+            steps_per_sec: None,
+        });
+    }
     let start = Instant::now();
     let batch = rollout(&env, &policy, args.n, args.horizon, key)
         .map_err(|e| CliError::usage(e.to_string()))?;
@@ -124,29 +159,25 @@ fn estimate(args: &EstimateArgs) -> Result<EstimateReport, CliError> {
     let fail = |e: sepg_estimators::EstimatorError| CliError::failure(e.to_string());
     estimator.value(&batch, &mut est).map_err(fail)?;
     let j = interval(&est)?;
-    let (grad_v, grad_w) = if policy.is_deterministic() {
-        (None, None)
-    } else {
-        let spec = GradientSpec::default();
-        estimator
-            .gradient(&batch, Param::V, spec, &mut est)
-            .map_err(fail)?;
-        let gv = interval(&est)?;
-        estimator
-            .gradient(&batch, Param::W, spec, &mut est)
-            .map_err(fail)?;
-        (Some(gv), Some(interval(&est)?))
-    };
+    let spec = GradientSpec::default();
+    estimator
+        .gradient(&batch, Param::V, spec, &mut est)
+        .map_err(fail)?;
+    let gv = interval(&est)?;
+    estimator
+        .gradient(&batch, Param::W, spec, &mut est)
+        .map_err(fail)?;
+    let (grad_v, grad_w) = (Some(gv), Some(interval(&est)?));
     Ok(EstimateReport {
         env: args.env.clone(),
         n: args.n,
         horizon: args.horizon,
         seed: args.seed,
-        steps,
+        steps: Some(steps),
         j,
         grad_v,
         grad_w,
-        steps_per_sec: steps as f64 / elapsed.max(1e-9),
+        steps_per_sec: Some(steps as f64 / elapsed.max(1e-9)),
     })
 }
 
@@ -185,10 +216,16 @@ pub fn run(args: &EstimateArgs) -> Result<(), CliError> {
                 out.push_str(&render(name, i));
             }
         }
-        out.push_str(&format!(
-            "{} trajectories, {} steps, {:.3e} steps/s\n",
-            r.n, r.steps, r.steps_per_sec
-        ));
+        match (r.steps, r.steps_per_sec) {
+            (Some(steps), Some(rate)) => out.push_str(&format!(
+                "{} trajectories, {steps} steps, {rate:.3e} steps/s\n",
+                r.n
+            )),
+            _ => out.push_str(&format!(
+                "{} trajectories of the deterministic policy\n",
+                r.n
+            )),
+        }
         print!("{out}");
     }
     Ok(())

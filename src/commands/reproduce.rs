@@ -24,16 +24,20 @@ pub struct ReproduceArgs {
     #[arg(long, value_enum)]
     preset: Option<LqgPreset>,
     /// Number of seeds (0..K).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
     seeds: u64,
     /// Iterations per run [default: 10000; 1000 for fig-5.4].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     iterations: Option<u64>,
     /// Confidence δ of the sampled gradients.
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(long, default_value_t = 0.2, allow_negative_numbers = true)]
     delta: f64,
     /// σ⁰ of the LQG figures (fig-5.1 to fig-5.3).
-    #[arg(long = "fig-sigma0", default_value_t = 1.0)]
+    #[arg(
+        long = "fig-sigma0",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     fig_sigma0: f64,
     /// Output folder [default: sepg-<experiment>].
     #[arg(long, value_name = "DIR")]
@@ -79,7 +83,15 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
         observer: &bar,
     };
     progress::install_interrupt_handler();
-    let (file, stats) = reproduce::run(&opts, &dir, mode, sweep_opts)?;
+    let (file, stats) =
+        reproduce::run(&opts, &dir, mode, sweep_opts).map_err(|e| match e {
+            sepg_runs::Error::SweepInterrupted { complete, runs, .. } => CliError::failure(format!(
+                "interrupted with {complete} of {runs} runs complete; resume with: sepg reproduce {} --resume --out {} (and the same options)",
+                args.what.name(),
+                dir.display()
+            )),
+            e => e.into(),
+        })?;
     if !args.quiet {
         eprintln!("{}", stats_line(&dir, &file, &stats));
     }

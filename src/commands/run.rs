@@ -32,7 +32,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
     /// Iterations between checkpoints (rows are appended to the log at each checkpoint).
-    #[arg(long = "checkpoint-every", value_name = "K", default_value_t = 500)]
+    #[arg(
+        long = "checkpoint-every",
+        value_name = "K",
+        default_value_t = 500,
+        allow_negative_numbers = true
+    )]
     checkpoint_every: u64,
 }
 
@@ -77,6 +82,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             return Err(CliError::usage(
                 "--resume takes no other options than --quiet and --checkpoint-every",
             ));
+        }
+        if folder::is_complete(dir) {
+            let s = folder::read_summary(dir)?;
+            if !args.quiet {
+                println!(
+                    "{}: already complete ({} iterations); nothing to resume",
+                    dir.display(),
+                    s.iterations
+                );
+            }
+            return Ok(());
         }
         (dir.clone(), run::resume(dir, opts)?)
     } else {

@@ -36,7 +36,12 @@ pub struct SweepArgs {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
     /// Iterations between checkpoints of each run.
-    #[arg(long = "checkpoint-every", value_name = "K", default_value_t = 2000)]
+    #[arg(
+        long = "checkpoint-every",
+        value_name = "K",
+        default_value_t = 2000,
+        allow_negative_numbers = true
+    )]
     checkpoint_every: u64,
 }
 

@@ -27,7 +27,7 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "FILE.md")]
     out: Option<PathBuf>,
     /// Master seed; each check derives its own stream from it and its identifier.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true, value_parser = sepg_runs::spec::parse_seed)]
     seed: u64,
     /// No progress bar.
     #[arg(long)]

@@ -468,7 +468,10 @@ impl<'h> Columns<'h> {
             let at = || format!("log line {line_no}, column {name}");
             let value = match kind {
                 Cell::Integer => Some(c.parse::<u64>().map_err(|_| {
-                    bad(dir, format!("{}: {c:?} is not a non-negative integer", at()))
+                    bad(
+                        dir,
+                        format!("{}: {c:?} is not a non-negative integer", at()),
+                    )
                 })? as f64),
                 _ if c.is_empty() => {
                     if *kind != Cell::Optional {
@@ -480,7 +483,8 @@ impl<'h> Columns<'h> {
                     let x = c
                         .parse::<f64>()
                         .map_err(|_| bad(dir, format!("{}: {c:?} is not a number", at())))?;
-                    let allowed = x.is_finite() || (*kind == Cell::WTarget && x == f64::NEG_INFINITY);
+                    let allowed =
+                        x.is_finite() || (*kind == Cell::WTarget && x == f64::NEG_INFINITY);
                     if !allowed {
                         return Err(bad(dir, format!("{}: {c} is not a finite number", at())));
                     }

@@ -32,6 +32,20 @@ pub enum Error {
         /// The run folder.
         dir: PathBuf,
     },
+    /// The stop flag was raised during a sweep; every unfinished run of it stopped at a
+    /// checkpoint, and the sweep resumes with `sepg sweep --resume`.
+    #[error(
+        "interrupted with {complete} of {runs} runs complete; resume with: sepg sweep --resume {}",
+        dir.display()
+    )]
+    SweepInterrupted {
+        /// Runs of the shard that are complete.
+        complete: usize,
+        /// Runs of the shard.
+        runs: usize,
+        /// The sweep folder.
+        dir: PathBuf,
+    },
 }
 
 impl Error {

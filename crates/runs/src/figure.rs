@@ -302,7 +302,7 @@ pub fn save(fig: &Figure, path: &Path) -> Result<()> {
                 Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
                 _ => PathBuf::from("."),
             };
-            let tmp = tempfile::Builder::new()
+            let tmp = crate::folder::output_builder(0o644)
                 .prefix(".sepg-figure-")
                 .suffix(".png")
                 .tempfile_in(&dir)

@@ -54,13 +54,7 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut builder = tempfile::Builder::new();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    let mut tmp = builder
+    let mut tmp = output_builder(0o644)
         .tempfile_in(dir)
         .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
     tmp.write_all(contents)
@@ -69,6 +63,21 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     tmp.persist(path)
         .map_err(|e| Error::failed(format!("cannot write {}: {}", path.display(), e.error)))?;
     Ok(())
+}
+
+/// A temporary-file builder whose file (or folder) is created with `mode` less the umask on
+/// Unix (0644 for files, 0755 for folders), instead of tempfile's private 0600/0700: outputs
+/// that are renamed into place keep the permissions of ordinary output files.
+pub(crate) fn output_builder<'a, 'b>(mode: u32) -> tempfile::Builder<'a, 'b> {
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(mode));
+    }
+    #[cfg(not(unix))]
+    let _ = mode;
+    builder
 }
 
 /// Serialises `value` as pretty JSON followed by a newline.

@@ -114,7 +114,7 @@ pub fn merge(shards: &[PathBuf], out: &Path, force: bool) -> Result<SweepFile> {
     };
     fs::create_dir_all(&parent)
         .map_err(|e| Error::failed(format!("cannot create {}: {e}", parent.display())))?;
-    let tmp = tempfile::Builder::new()
+    let tmp = crate::folder::output_builder(0o755)
         .prefix(".sepg-merge-")
         .tempdir_in(&parent)
         .map_err(|e| Error::failed(format!("cannot write in {}: {e}", parent.display())))?;

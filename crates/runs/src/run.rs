@@ -196,11 +196,20 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     let mut tally = writer.ck.tally.clone();
     let period = opts.checkpoint_every.max(1);
     while state.iteration < total {
+        let before = state.clone();
         let record = match solver.next_iter(&mut state) {
             Ok(r) => r,
             Err(e) => {
                 opts.observer.end();
-                return Err(Error::failed(format!("{}: {e}", dir.display())));
+                // Keep every row computed so far: checkpoint the state the failing iteration
+                // started from, with the rows up to it.
+                writer.checkpoint(&tally, &before)?;
+                return Err(Error::failed(format!(
+                    "{}: iteration {} failed ({e}); the {} row(s) before it are kept in {PARTIAL_LOG_FILE}",
+                    dir.display(),
+                    before.iteration,
+                    before.iteration
+                )));
             }
         };
         tally.add(&record);

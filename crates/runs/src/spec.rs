@@ -308,19 +308,19 @@ pub struct RunSpec {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lr_w: Option<f64>,
     /// Trajectories per iteration N [default: 100].
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, allow_negative_numbers = true))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub batch: Option<usize>,
     /// Horizon H [default: 20; 999 for mountain-car].
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, allow_negative_numbers = true))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub horizon: Option<usize>,
     /// Iterations [default: 10000].
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, allow_negative_numbers = true))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iterations: Option<u64>,
     /// Seed [default: 0].
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_seed))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
     /// Gradient estimator of the sampled mode [default: gpomdp].
@@ -676,6 +676,32 @@ struct Start {
     v0: Vec<f64>,
     sigma0: Vec<f64>,
     budget0: f64,
+}
+
+/// Parses a seed: a non-negative integer below 2⁶⁴ (seeds index the random streams of
+/// `sepg_mdp::rng`, which are keyed by unsigned 64-bit integers). The message says why a
+/// negative or non-integer value is refused.
+///
+/// # Errors
+/// A one-line message for anything else.
+///
+/// # Example
+/// ```
+/// use sepg_runs::spec::parse_seed;
+/// assert_eq!(parse_seed("7"), Ok(7));
+/// assert!(parse_seed("-1").unwrap_err().contains("non-negative"));
+/// ```
+pub fn parse_seed(s: &str) -> std::result::Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| {
+        let why = if s.trim().parse::<i128>().is_ok_and(|x| x < 0) {
+            "it is negative"
+        } else if s.trim().parse::<i128>().is_ok() {
+            "it is too large"
+        } else {
+            "it is not an integer"
+        };
+        format!("a seed is a non-negative integer in 0..=18446744073709551615 (u64), and {why}")
+    })
 }
 
 /// Batch size, horizon, iterations, seed and log stride.

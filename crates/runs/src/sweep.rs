@@ -391,8 +391,26 @@ pub fn execute(
         })
         .collect();
     opts.observer.end();
-    if let Some(Err(e)) = results.into_iter().find(Result::is_err) {
+    let interrupted = results
+        .iter()
+        .any(|r| matches!(r, Err(Error::Interrupted { .. })));
+    // A failure is reported before an interruption: it is what the user must fix.
+    if let Some(Err(e)) = results.into_iter().find(|r| {
+        r.as_ref()
+            .is_err_and(|e| !matches!(e, Error::Interrupted { .. }))
+    }) {
         return Err(e);
+    }
+    if interrupted {
+        let runs: Vec<&RunEntry> = file.shard_runs().collect();
+        return Err(Error::SweepInterrupted {
+            complete: runs
+                .iter()
+                .filter(|r| is_complete(&dir.join(&r.dir)))
+                .count(),
+            runs: runs.len(),
+            dir: dir.to_path_buf(),
+        });
     }
     Ok(SweepStats {
         runs: todo.len(),
