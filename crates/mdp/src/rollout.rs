@@ -148,8 +148,13 @@ pub fn rollout_into<E: Environment + ?Sized>(
         fill_batch_scalar(batch, key, p, pol, limit);
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
-        fill_batch(batch, key, dims, |rngs, rw, sv, sw, sc| {
-            generic_kernel::<E, true>(env, policy, gamma, limit, rngs, rw, sv, sw, sc).0
+        fill_batch(batch, key, dims, |rngs, rewards, score_v, score_w, sc| {
+            let mut rows = TrajRows {
+                rewards,
+                score_v,
+                score_w,
+            };
+            generic_kernel(env, policy, gamma, limit, rngs, &mut rows, sc).0
         });
     }
     let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
@@ -236,18 +241,7 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
         fill_returns(out, key, dims, |rngs, sc| {
-            generic_kernel::<E, false>(
-                env,
-                policy,
-                gamma,
-                limit,
-                rngs,
-                &mut [],
-                &mut [],
-                &mut [],
-                sc,
-            )
-            .1
+            generic_kernel(env, policy, gamma, limit, rngs, &mut NoSteps, sc).1
         });
     }
     if out.iter().all(|x| x.is_finite()) {
@@ -311,7 +305,7 @@ pub fn evaluate_mean_policy<E: Environment + ?Sized>(
     mean_return(env, &policy.to_deterministic(), n, horizon, key)
 }
 
-fn check<E: Environment + ?Sized>(
+pub(crate) fn check<E: Environment + ?Sized>(
     env: &E,
     policy: &GaussianPolicy,
     n: usize,
@@ -335,18 +329,20 @@ fn check<E: Environment + ?Sized>(
     Ok(())
 }
 
-/// Per-chunk work buffers of the generic kernel.
-struct Scratch {
+/// Per-chunk work buffers of the generic kernel. After a trajectory, `cum_v` and `cum_w` hold
+/// its final cumulative scores.
+pub(crate) struct Scratch {
     state: Vec<f64>,
     next: Vec<f64>,
     phi: Vec<f64>,
     action: Vec<f64>,
-    cum_v: Vec<f64>,
-    cum_w: Vec<f64>,
+    pub(crate) cum_v: Vec<f64>,
+    pub(crate) cum_w: Vec<f64>,
 }
 
 impl Scratch {
-    fn new((n, l, p): (usize, usize, usize)) -> Self {
+    /// Buffers for `(state, action, feature)` dimensions `(n, l, p)`.
+    pub(crate) fn new((n, l, p): (usize, usize, usize)) -> Self {
         Scratch {
             state: vec![0.0; n],
             next: vec![0.0; n],
@@ -355,6 +351,77 @@ impl Scratch {
             cum_v: vec![0.0; l * p],
             cum_w: vec![0.0; l],
         }
+    }
+}
+
+/// What the generic kernel does with each step of a trajectory: `record(t, γ^t r_t, S^v_t,
+/// S^w_t)` with the cumulative scores after step `t` (only meaningful when `SCORES`).
+pub(crate) trait TrajSink {
+    /// Whether the kernel must accumulate the scores.
+    const SCORES: bool;
+    /// Step `t` of the trajectory.
+    fn record(&mut self, t: usize, dr: f64, cum_v: &[f64], cum_w: &[f64]);
+}
+
+/// Discards the steps (returns-only rollouts).
+pub(crate) struct NoSteps;
+
+impl TrajSink for NoSteps {
+    const SCORES: bool = false;
+    #[inline(always)]
+    fn record(&mut self, _: usize, _: f64, _: &[f64], _: &[f64]) {}
+}
+
+impl<const K: usize> LaneSink<K> for NoSteps {
+    const SCORES: bool = false;
+    #[inline(always)]
+    fn record(&mut self, _: usize, _: usize, _: f64, _: f64, _: f64) {}
+}
+
+/// Writes the steps into one trajectory's [`Batch`] rows.
+struct TrajRows<'a> {
+    rewards: &'a mut [f64],
+    score_v: &'a mut [f64],
+    score_w: &'a mut [f64],
+}
+
+impl TrajSink for TrajRows<'_> {
+    const SCORES: bool = true;
+    #[inline(always)]
+    fn record(&mut self, t: usize, dr: f64, cum_v: &[f64], cum_w: &[f64]) {
+        let (dv, l) = (cum_v.len(), cum_w.len());
+        self.rewards[t] = dr;
+        self.score_v[t * dv..(t + 1) * dv].copy_from_slice(cum_v);
+        self.score_w[t * l..(t + 1) * l].copy_from_slice(cum_w);
+    }
+}
+
+/// What the fused scalar kernel does with step `t` of lane `k`: `record(k, t, γ^t r_t, S^v_t,
+/// S^w_t)` (scores only meaningful when `SCORES`).
+pub(crate) trait LaneSink<const K: usize> {
+    /// Whether the kernel must accumulate the scores.
+    const SCORES: bool;
+    /// Step `t` of lane `k`.
+    fn record(&mut self, k: usize, t: usize, dr: f64, cv: f64, cw: f64);
+}
+
+/// Writes the steps into the [`Batch`] rows of `K` consecutive trajectories (rows of length
+/// `h` back to back).
+struct LaneRows<'a> {
+    rw: &'a mut [f64],
+    sv: &'a mut [f64],
+    sw: &'a mut [f64],
+    h: usize,
+}
+
+impl<const K: usize> LaneSink<K> for LaneRows<'_> {
+    const SCORES: bool = true;
+    #[inline(always)]
+    fn record(&mut self, k: usize, t: usize, dr: f64, cv: f64, cw: f64) {
+        let i = k * self.h + t;
+        self.rw[i] = dr;
+        self.sv[i] = cv;
+        self.sw[i] = cw;
     }
 }
 
@@ -432,14 +499,14 @@ where
 /// Trajectories advanced in lockstep by the fused scalar kernel. Each trajectory is a serial
 /// chain of dependent floating-point operations; interleaving independent trajectories lets
 /// the CPU overlap their latencies. The arithmetic of each trajectory is unchanged.
-const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 
 /// Mean gain and noise scale of a one-feature, one-action policy.
 #[derive(Clone, Copy)]
-struct ScalarPolicy {
-    v: f64,
-    sigma: f64,
-    inv_sigma: f64,
+pub(crate) struct ScalarPolicy {
+    pub(crate) v: f64,
+    pub(crate) sigma: f64,
+    pub(crate) inv_sigma: f64,
 }
 
 /// [`fill_batch`] for the scalar LQG, running the fused kernel on groups of [`LANES`]
@@ -505,7 +572,14 @@ fn scalar_group<const K: usize>(
 ) {
     let mut rngs: [TrajectoryRngs; K] =
         std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-    scalar_kernel::<K, true, true>(p, pol, limit, &mut rngs, [r, v, w], h);
+    let limit = limit.min(h);
+    let mut rows = LaneRows {
+        rw: &mut r[..K * h],
+        sv: &mut v[..K * h],
+        sw: &mut w[..K * h],
+        h,
+    };
+    scalar_kernel::<K, _, true>(p, pol, limit, &mut rngs, &mut rows);
 }
 
 /// [`fill_returns`] for the scalar LQG (`STOCH = false`: the deterministic policy).
@@ -525,42 +599,39 @@ fn fill_returns_scalar<const STOCH: bool>(
                 if group.len() == LANES {
                     let mut rngs: [TrajectoryRngs; LANES] =
                         std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-                    group.copy_from_slice(&scalar_kernel::<LANES, false, STOCH>(
+                    group.copy_from_slice(&scalar_kernel::<LANES, _, STOCH>(
                         p,
                         pol,
                         limit,
                         &mut rngs,
-                        [&mut [], &mut [], &mut []],
-                        0,
+                        &mut NoSteps,
                     ));
                 } else {
                     for (k, g) in group.iter_mut().enumerate() {
                         let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
-                        let rows = [&mut [][..], &mut [], &mut []];
-                        *g = scalar_kernel::<1, false, STOCH>(p, pol, limit, &mut rngs, rows, 0)[0];
+                        *g =
+                            scalar_kernel::<1, _, STOCH>(p, pol, limit, &mut rngs, &mut NoSteps)[0];
                     }
                 }
             }
         });
 }
 
-/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep.
-/// `rows = [rewards, cum v-scores, cum w-scores]`, each holding the `K` trajectories' rows of
-/// length `h ≥ limit` back to back (written only when `SCORES`). `STOCH = false` is the
-/// deterministic policy (no draws from the policy stream). Returns the discounted returns.
+/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep,
+/// for `limit` steps; every step goes to `sink`. `STOCH = false` is the deterministic policy
+/// (no draws from the policy stream). Returns the discounted returns.
 #[inline(always)]
-fn scalar_kernel<const K: usize, const SCORES: bool, const STOCH: bool>(
+pub(crate) fn scalar_kernel<const K: usize, S: LaneSink<K>, const STOCH: bool>(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
     rngs: &mut [TrajectoryRngs; K],
-    rows: [&mut [f64]; 3],
-    h: usize,
+    sink: &mut S,
 ) -> [f64; K] {
     if p.clipping {
-        scalar_kernel_impl::<K, SCORES, STOCH, true>(p, pol, limit, rngs, rows, h)
+        scalar_kernel_impl::<K, S, STOCH, true>(p, pol, limit, rngs, sink)
     } else {
-        scalar_kernel_impl::<K, SCORES, STOCH, false>(p, pol, limit, rngs, rows, h)
+        scalar_kernel_impl::<K, S, STOCH, false>(p, pol, limit, rngs, sink)
     }
 }
 
@@ -568,13 +639,12 @@ fn scalar_kernel<const K: usize, const SCORES: bool, const STOCH: bool>(
 /// lanes' variates (policy stream, then environment stream, in the same per-stream order as
 /// the generic kernel), then runs the short branch-free arithmetic over the lanes.
 #[inline(always)]
-fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, const CLIP: bool>(
+fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const CLIP: bool>(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
     rngs: &mut [TrajectoryRngs; K],
-    rows: [&mut [f64]; 3],
-    h: usize,
+    sink: &mut S,
 ) -> [f64; K] {
     let p = *p;
     let ScalarPolicy {
@@ -586,13 +656,6 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
     let mut s: [f64; K] =
         std::array::from_fn(|k| uniform(&mut rngs[k].env, p.init_low, p.init_high));
     let (mut cv, mut cw, mut ret) = ([0.0; K], [0.0; K], [0.0; K]);
-    let [rw, sv, sw] = rows;
-    let (rw, sv, sw, limit) = if SCORES {
-        let limit = limit.min(h);
-        (&mut rw[..K * h], &mut sv[..K * h], &mut sw[..K * h], limit)
-    } else {
-        (rw, sv, sw, limit)
-    };
     let mut disc = 1.0;
     let (mut z, mut eta) = ([0.0; K], [0.0; K]);
     for t in 0..limit {
@@ -611,7 +674,7 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
             let mu = v * sk;
             let a = if STOCH {
                 let zk = z[k];
-                if SCORES {
+                if S::SCORES {
                     cv[k] += zk * inv_sigma * sk;
                     cw[k] += zk * zk - 1.0;
                 }
@@ -626,11 +689,7 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
             };
             let r = -(sk * (p.q * sk) + ac * (p.r * ac));
             let dr = disc * r;
-            if SCORES {
-                rw[k * h + t] = dr;
-                sv[k * h + t] = cv[k];
-                sw[k * h + t] = cw[k];
-            }
+            sink.record(k, t, dr, cv[k], cw[k]);
             ret[k] += dr;
             let mut x = p.a * sk + p.b * ac;
             if noisy {
@@ -650,22 +709,19 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
 /// The generic kernel over any [`Environment`]. Returns `(len, G)`; stops after a terminal
 /// step.
 #[allow(clippy::too_many_arguments)]
-fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
+pub(crate) fn generic_kernel<E: Environment + ?Sized, S: TrajSink>(
     env: &E,
     policy: &GaussianPolicy,
     gamma: f64,
     limit: usize,
     rngs: &mut TrajectoryRngs,
-    rewards: &mut [f64],
-    score_v: &mut [f64],
-    score_w: &mut [f64],
+    sink: &mut S,
     sc: &mut Scratch,
 ) -> (usize, f64) {
     let (sigma, inv_sigma) = policy.sigma_raw();
     let stochastic = !policy.is_deterministic();
     let p = policy.feature_dim();
     let l = policy.action_dim();
-    let dv = l * p;
     env.reset(&mut rngs.env, &mut sc.state);
     sc.cum_v.fill(0.0);
     sc.cum_w.fill(0.0);
@@ -676,7 +732,7 @@ fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
             let mu = policy.mean_j(&sc.phi, j);
             sc.action[j] = if stochastic {
                 let z = standard_normal(&mut rngs.policy);
-                if SCORES {
+                if S::SCORES {
                     let c = z * inv_sigma[j];
                     for (cv, f) in sc.cum_v[j * p..(j + 1) * p].iter_mut().zip(&sc.phi) {
                         *cv += c * f;
@@ -690,11 +746,7 @@ fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
         }
         let (r, done) = env.step(&sc.state, &sc.action, &mut rngs.env, &mut sc.next);
         let dr = disc * r;
-        if SCORES {
-            rewards[t] = dr;
-            score_v[t * dv..(t + 1) * dv].copy_from_slice(&sc.cum_v);
-            score_w[t * l..(t + 1) * l].copy_from_slice(&sc.cum_w);
-        }
+        sink.record(t, dr, &sc.cum_v, &sc.cum_w);
         ret += dr;
         disc *= gamma;
         std::mem::swap(&mut sc.state, &mut sc.next);
@@ -735,9 +787,19 @@ mod tests {
             let fast = rollout(&env, &pi, n, h, key).unwrap();
             let mut slow = fast.clone();
             let gamma = env.constants().gamma;
-            fill_batch(&mut slow, key, (1, 1, 1), |rngs, rw, sv, sw, sc| {
-                generic_kernel::<LqgEnv, true>(&env, &pi, gamma, h, rngs, rw, sv, sw, sc).0
-            });
+            fill_batch(
+                &mut slow,
+                key,
+                (1, 1, 1),
+                |rngs, rewards, score_v, score_w, sc| {
+                    let mut rows = TrajRows {
+                        rewards,
+                        score_v,
+                        score_w,
+                    };
+                    generic_kernel(&env, &pi, gamma, h, rngs, &mut rows, sc).0
+                },
+            );
             assert_eq!(fast, slow);
             let fast_g = rollout_returns(&env, &pi, n, h, key).unwrap();
             let det = pi.to_deterministic();
@@ -745,32 +807,10 @@ mod tests {
             for i in 0..n {
                 let mut sc = Scratch::new((1, 1, 1));
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel::<LqgEnv, false>(
-                    &env,
-                    &pi,
-                    gamma,
-                    h,
-                    &mut rngs,
-                    &mut [],
-                    &mut [],
-                    &mut [],
-                    &mut sc,
-                )
-                .1;
+                let g = generic_kernel(&env, &pi, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_g[i].to_bits());
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel::<LqgEnv, false>(
-                    &env,
-                    &det,
-                    gamma,
-                    h,
-                    &mut rngs,
-                    &mut [],
-                    &mut [],
-                    &mut [],
-                    &mut sc,
-                )
-                .1;
+                let g = generic_kernel(&env, &det, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_det[i].to_bits());
             }
         }
