@@ -82,6 +82,11 @@ pub trait Environment: Sync {
     fn feature_dim(&self) -> usize;
     /// The constants used by the bounds.
     fn constants(&self) -> EnvConstants;
+    /// The discount factor `γ` of [`Environment::constants`], without computing the other
+    /// constants (`r_max` can take a search over the box corners).
+    fn gamma(&self) -> f64 {
+        self.constants().gamma
+    }
     /// A step limit after which an episode is truncated (not terminated), if any.
     fn time_limit(&self) -> Option<usize> {
         None
@@ -252,6 +257,10 @@ impl Environment for LqgEnv {
 
     fn feature_dim(&self) -> usize {
         self.n
+    }
+
+    fn gamma(&self) -> f64 {
+        self.model.gamma
     }
 
     fn constants(&self) -> EnvConstants {
@@ -442,6 +451,10 @@ impl Environment for AnyEnv {
 
     fn constants(&self) -> EnvConstants {
         dispatch!(self, e => e.constants())
+    }
+
+    fn gamma(&self) -> f64 {
+        dispatch!(self, e => e.gamma())
     }
 
     fn time_limit(&self) -> Option<usize> {

@@ -150,6 +150,10 @@ impl Environment for MountainCar {
         }
     }
 
+    fn gamma(&self) -> f64 {
+        self.gamma
+    }
+
     fn time_limit(&self) -> Option<usize> {
         Some(TIME_LIMIT)
     }

@@ -125,7 +125,7 @@ pub fn rollout_into<E: Environment + ?Sized>(
     let cells = n.checked_mul(horizon).ok_or(RolloutError::TooLarge)?;
     let cells_v = cells.checked_mul(dim_v).ok_or(RolloutError::TooLarge)?;
     let cells_w = cells.checked_mul(dim_w).ok_or(RolloutError::TooLarge)?;
-    let gamma = env.constants().gamma;
+    let gamma = env.gamma();
     batch.n = n;
     batch.horizon = horizon;
     batch.dim_v = dim_v;
@@ -139,13 +139,13 @@ pub fn rollout_into<E: Environment + ?Sized>(
     batch.lengths.resize(n, 0);
     let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
 
-    if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
+    let finite = if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
         let pol = ScalarPolicy {
             v: policy.v()[0],
             sigma: sigma[0],
             inv_sigma: inv_sigma[0],
         };
-        fill_batch_scalar(batch, key, p, pol, limit);
+        fill_batch_scalar(batch, key, p, pol, limit)
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
         fill_batch(batch, key, dims, |rngs, rewards, score_v, score_w, sc| {
@@ -154,11 +154,11 @@ pub fn rollout_into<E: Environment + ?Sized>(
                 score_v,
                 score_w,
             };
-            generic_kernel(env, policy, gamma, limit, rngs, &mut rows, sc).0
-        });
-    }
-    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
-    if finite(&batch.disc_rewards) && finite(&batch.cum_score_v) && finite(&batch.cum_score_w) {
+            let (len, g) = generic_kernel(env, policy, gamma, limit, rngs, &mut rows, sc);
+            (len, finite_trajectory(g, &sc.cum_v, &sc.cum_w))
+        })
+    };
+    if finite {
         Ok(())
     } else {
         Err(RolloutError::NonFinite)
@@ -218,7 +218,7 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
 ) -> Result<(), RolloutError> {
     check(env, policy, n, horizon)?;
     out.resize(n, 0.0);
-    let gamma = env.constants().gamma;
+    let gamma = env.gamma();
     let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
     let (sigma, inv_sigma) = policy.sigma_raw();
     if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
@@ -425,14 +425,45 @@ impl<const K: usize> LaneSink<K> for LaneRows<'_> {
     }
 }
 
-/// Runs `kernel` for every trajectory of `batch` in parallel chunks and pads each trajectory
-/// after its length (rewards 0, cumulative scores frozen).
-fn fill_batch<F>(batch: &mut Batch, key: SeedKey, dims: (usize, usize, usize), kernel: F)
+/// Runs `kernel` for every trajectory of `batch` in parallel chunks (on the calling thread when
+/// there is a single chunk) and pads each trajectory after its length (rewards 0, cumulative
+/// scores frozen). `kernel` returns the length and whether the trajectory is finite; returns
+/// whether every trajectory is.
+fn fill_batch<F>(batch: &mut Batch, key: SeedKey, dims: (usize, usize, usize), kernel: F) -> bool
 where
-    F: Fn(&mut TrajectoryRngs, &mut [f64], &mut [f64], &mut [f64], &mut Scratch) -> usize + Sync,
+    F: Fn(&mut TrajectoryRngs, &mut [f64], &mut [f64], &mut [f64], &mut Scratch) -> (usize, bool)
+        + Sync,
 {
     let (h, dv, dw) = (batch.horizon, batch.dim_v, batch.dim_w);
     let prefix = key.prefix();
+    let body = |c: usize, rw: &mut [f64], sv: &mut [f64], sw: &mut [f64], lens: &mut [usize]| {
+        let mut scratch = Scratch::new(dims);
+        let trajectories = rw
+            .chunks_exact_mut(h)
+            .zip(sv.chunks_exact_mut(h * dv))
+            .zip(sw.chunks_exact_mut(h * dw))
+            .zip(lens.iter_mut());
+        let mut finite = true;
+        for (k, (((r, v), w), len)) in trajectories.enumerate() {
+            let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+            let (l, ok) = kernel(&mut rngs, r, v, w, &mut scratch);
+            pad(r, v, dv, l);
+            pad_scores(w, dw, l);
+            *len = l;
+            finite &= ok;
+        }
+        finite
+    };
+    if batch.n <= CHUNK {
+        let b = batch;
+        return body(
+            0,
+            &mut b.disc_rewards,
+            &mut b.cum_score_v,
+            &mut b.cum_score_w,
+            &mut b.lengths,
+        );
+    }
     batch
         .disc_rewards
         .par_chunks_mut(CHUNK * h)
@@ -440,21 +471,16 @@ where
         .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h * dw))
         .zip(batch.lengths.par_chunks_mut(CHUNK))
         .enumerate()
-        .for_each(|(c, (((rw, sv), sw), lens))| {
-            let mut scratch = Scratch::new(dims);
-            let trajectories = rw
-                .chunks_exact_mut(h)
-                .zip(sv.chunks_exact_mut(h * dv))
-                .zip(sw.chunks_exact_mut(h * dw))
-                .zip(lens.iter_mut());
-            for (k, (((r, v), w), len)) in trajectories.enumerate() {
-                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
-                let l = kernel(&mut rngs, r, v, w, &mut scratch);
-                pad(r, v, dv, l);
-                pad_scores(w, dw, l);
-                *len = l;
-            }
-        });
+        .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
+        .reduce(|| true, |a, b| a & b)
+}
+
+/// Whether a trajectory with return `g` and final cumulative scores `cum_v`, `cum_w` has only
+/// finite rewards and scores: a running sum that meets ±∞ or NaN never becomes finite again,
+/// so checking the sums checks every term.
+#[inline]
+fn finite_trajectory(g: f64, cum_v: &[f64], cum_w: &[f64]) -> bool {
+    g.is_finite() && cum_v.iter().chain(cum_w).all(|x| x.is_finite())
 }
 
 /// Zero rewards from `len` on, freeze the v-scores at their last value.
@@ -479,21 +505,27 @@ fn pad_scores(scores: &mut [f64], dim: usize, len: usize) {
     }
 }
 
-/// Runs `kernel` for every trajectory in parallel chunks, storing its discounted return.
+/// Runs `kernel` for every trajectory in parallel chunks (on the calling thread when there is
+/// a single chunk), storing its discounted return.
 fn fill_returns<F>(out: &mut [f64], key: SeedKey, dims: (usize, usize, usize), kernel: F)
 where
     F: Fn(&mut TrajectoryRngs, &mut Scratch) -> f64 + Sync,
 {
     let prefix = key.prefix();
-    out.par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, chunk)| {
-            let mut scratch = Scratch::new(dims);
-            for (k, g) in chunk.iter_mut().enumerate() {
-                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
-                *g = kernel(&mut rngs, &mut scratch);
-            }
-        });
+    let body = |c: usize, chunk: &mut [f64]| {
+        let mut scratch = Scratch::new(dims);
+        for (k, g) in chunk.iter_mut().enumerate() {
+            let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+            *g = kernel(&mut rngs, &mut scratch);
+        }
+    };
+    if out.len() <= CHUNK {
+        body(0, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| body(c, chunk));
+    }
 }
 
 /// Trajectories advanced in lockstep by the fused scalar kernel. Each trajectory is a serial
@@ -517,9 +549,47 @@ fn fill_batch_scalar(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
-) {
+) -> bool {
     let h = batch.horizon;
     let prefix = key.prefix();
+    let body = |c: usize, rw: &mut [f64], sv: &mut [f64], sw: &mut [f64], lens: &mut [usize]| {
+        let groups = rw
+            .chunks_mut(LANES * h)
+            .zip(sv.chunks_mut(LANES * h))
+            .zip(sw.chunks_mut(LANES * h))
+            .zip(lens.chunks_mut(LANES));
+        let mut finite = true;
+        for (g, (((r, v), w), ls)) in groups.enumerate() {
+            let first = (c * CHUNK + g * LANES) as u64;
+            if ls.len() == LANES {
+                finite &= scalar_group::<LANES>(p, pol, limit, prefix, first, r, v, w, h);
+            } else {
+                for k in 0..ls.len() {
+                    let span = k * h..(k + 1) * h;
+                    let (rk, vk, wk) = (&mut r[span.clone()], &mut v[span.clone()], &mut w[span]);
+                    finite &=
+                        scalar_group::<1>(p, pol, limit, prefix, first + k as u64, rk, vk, wk, h);
+                }
+            }
+            for (k, len) in ls.iter_mut().enumerate() {
+                let span = k * h..(k + 1) * h;
+                pad(&mut r[span.clone()], &mut v[span.clone()], 1, limit);
+                pad_scores(&mut w[span], 1, limit);
+                *len = limit;
+            }
+        }
+        finite
+    };
+    if batch.n <= CHUNK {
+        let b = batch;
+        return body(
+            0,
+            &mut b.disc_rewards,
+            &mut b.cum_score_v,
+            &mut b.cum_score_w,
+            &mut b.lengths,
+        );
+    }
     batch
         .disc_rewards
         .par_chunks_mut(CHUNK * h)
@@ -527,36 +597,13 @@ fn fill_batch_scalar(
         .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h))
         .zip(batch.lengths.par_chunks_mut(CHUNK))
         .enumerate()
-        .for_each(|(c, (((rw, sv), sw), lens))| {
-            let groups = rw
-                .chunks_mut(LANES * h)
-                .zip(sv.chunks_mut(LANES * h))
-                .zip(sw.chunks_mut(LANES * h))
-                .zip(lens.chunks_mut(LANES));
-            for (g, (((r, v), w), ls)) in groups.enumerate() {
-                let first = (c * CHUNK + g * LANES) as u64;
-                if ls.len() == LANES {
-                    scalar_group::<LANES>(p, pol, limit, prefix, first, r, v, w, h);
-                } else {
-                    for k in 0..ls.len() {
-                        let span = k * h..(k + 1) * h;
-                        let (rk, vk, wk) =
-                            (&mut r[span.clone()], &mut v[span.clone()], &mut w[span]);
-                        scalar_group::<1>(p, pol, limit, prefix, first + k as u64, rk, vk, wk, h);
-                    }
-                }
-                for (k, len) in ls.iter_mut().enumerate() {
-                    let span = k * h..(k + 1) * h;
-                    pad(&mut r[span.clone()], &mut v[span.clone()], 1, limit);
-                    pad_scores(&mut w[span], 1, limit);
-                    *len = limit;
-                }
-            }
-        });
+        .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
+        .reduce(|| true, |a, b| a & b)
 }
 
 /// Runs the scored scalar kernel on `K` consecutive trajectories whose rows are consecutive in
-/// `r`, `v`, `w` (each of length `K · h`).
+/// `r`, `v`, `w` (each of length `K · h`); returns whether they are all finite
+/// ([`finite_trajectory`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn scalar_group<const K: usize>(
@@ -569,7 +616,7 @@ fn scalar_group<const K: usize>(
     v: &mut [f64],
     w: &mut [f64],
     h: usize,
-) {
+) -> bool {
     let mut rngs: [TrajectoryRngs; K] =
         std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
     let limit = limit.min(h);
@@ -579,7 +626,9 @@ fn scalar_group<const K: usize>(
         sw: &mut w[..K * h],
         h,
     };
-    scalar_kernel::<K, _, true>(p, pol, limit, &mut rngs, &mut rows);
+    let g = scalar_kernel::<K, _, true>(p, pol, limit, &mut rngs, &mut rows);
+    let last = limit - 1;
+    (0..K).all(|k| finite_trajectory(g[k], &v[k * h + last..][..1], &w[k * h + last..][..1]))
 }
 
 /// [`fill_returns`] for the scalar LQG (`STOCH = false`: the deterministic policy).
@@ -591,30 +640,34 @@ fn fill_returns_scalar<const STOCH: bool>(
     limit: usize,
 ) {
     let prefix = key.prefix();
-    out.par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, chunk)| {
-            for (g, group) in chunk.chunks_mut(LANES).enumerate() {
-                let first = (c * CHUNK + g * LANES) as u64;
-                if group.len() == LANES {
-                    let mut rngs: [TrajectoryRngs; LANES] =
-                        std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-                    group.copy_from_slice(&scalar_kernel::<LANES, _, STOCH>(
-                        p,
-                        pol,
-                        limit,
-                        &mut rngs,
-                        &mut NoSteps,
-                    ));
-                } else {
-                    for (k, g) in group.iter_mut().enumerate() {
-                        let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
-                        *g =
-                            scalar_kernel::<1, _, STOCH>(p, pol, limit, &mut rngs, &mut NoSteps)[0];
-                    }
+    let body = |c: usize, chunk: &mut [f64]| {
+        for (g, group) in chunk.chunks_mut(LANES).enumerate() {
+            let first = (c * CHUNK + g * LANES) as u64;
+            if group.len() == LANES {
+                let mut rngs: [TrajectoryRngs; LANES] =
+                    std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
+                group.copy_from_slice(&scalar_kernel::<LANES, _, STOCH>(
+                    p,
+                    pol,
+                    limit,
+                    &mut rngs,
+                    &mut NoSteps,
+                ));
+            } else {
+                for (k, g) in group.iter_mut().enumerate() {
+                    let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
+                    *g = scalar_kernel::<1, _, STOCH>(p, pol, limit, &mut rngs, &mut NoSteps)[0];
                 }
             }
-        });
+        }
+    };
+    if out.len() <= CHUNK {
+        body(0, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| body(c, chunk));
+    }
 }
 
 /// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep,
@@ -786,7 +839,7 @@ mod tests {
             let env = LqgEnv::new(model).unwrap();
             let fast = rollout(&env, &pi, n, h, key).unwrap();
             let mut slow = fast.clone();
-            let gamma = env.constants().gamma;
+            let gamma = env.gamma();
             fill_batch(
                 &mut slow,
                 key,
@@ -797,7 +850,10 @@ mod tests {
                         score_v,
                         score_w,
                     };
-                    generic_kernel(&env, &pi, gamma, h, rngs, &mut rows, sc).0
+                    (
+                        generic_kernel(&env, &pi, gamma, h, rngs, &mut rows, sc).0,
+                        true,
+                    )
                 },
             );
             assert_eq!(fast, slow);

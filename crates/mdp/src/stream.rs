@@ -97,7 +97,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             env,
             policy,
             scalar,
-            gamma: env.constants().gamma,
+            gamma: env.gamma(),
             limit: env.time_limit().map_or(horizon, |tl| tl.min(horizon)),
             horizon,
             prefix: key.prefix(),
