@@ -109,6 +109,11 @@ pub trait Environment: Sync {
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
         None
     }
+    /// The Mountain Car behind this environment, if it is one: with state + bias features,
+    /// rollouts then run a fused specialised kernel with identical results.
+    fn as_mountain_car(&self) -> Option<&MountainCar> {
+        None
+    }
 }
 
 /// Scalar coefficients of a one-dimensional LQG, cached for the fused rollout kernel.
@@ -481,5 +486,9 @@ impl Environment for AnyEnv {
 
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
         dispatch!(self, e => e.as_scalar_lqg())
+    }
+
+    fn as_mountain_car(&self) -> Option<&MountainCar> {
+        dispatch!(self, e => e.as_mountain_car())
     }
 }

@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use crate::batch::Batch;
 use crate::env::{Environment, ScalarLqg};
+use crate::features::FeatureMap;
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uniform};
 
@@ -148,13 +149,14 @@ pub fn rollout_into<E: Environment + ?Sized>(
         fill_batch_scalar(batch, key, p, pol, limit)
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
+        let fused = FusedPolicy::of(env, policy);
         fill_batch(batch, key, dims, |rngs, rewards, score_v, score_w, sc| {
             let mut rows = TrajRows {
                 rewards,
                 score_v,
                 score_w,
             };
-            let (len, g) = generic_kernel(env, policy, gamma, limit, rngs, &mut rows, sc);
+            let (len, g) = kernel(env, policy, fused, gamma, limit, rngs, &mut rows, sc);
             (len, finite_trajectory(g, &sc.cum_v, &sc.cum_w))
         })
     };
@@ -240,8 +242,9 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
         }
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
+        let fused = FusedPolicy::of(env, policy);
         fill_returns(out, key, dims, |rngs, sc| {
-            generic_kernel(env, policy, gamma, limit, rngs, &mut NoSteps, sc).1
+            kernel(env, policy, fused, gamma, limit, rngs, &mut NoSteps, sc).1
         });
     }
     if out.iter().all(|x| x.is_finite()) {
@@ -759,6 +762,106 @@ fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const C
     ret
 }
 
+/// The policy of a rollout that runs a fused kernel instead of the generic one: Mountain Car
+/// with state + bias features (`φ = [pos, vel, 1]`, one action).
+#[derive(Clone, Copy)]
+pub(crate) struct FusedPolicy {
+    v: [f64; 3],
+    sigma: f64,
+    inv_sigma: f64,
+    stochastic: bool,
+}
+
+impl FusedPolicy {
+    /// The fused Mountain Car policy, if `env` and `policy` have that shape.
+    pub(crate) fn of<E: Environment + ?Sized>(env: &E, policy: &GaussianPolicy) -> Option<Self> {
+        let mc = env.as_mountain_car()?;
+        let state_bias = matches!(mc.feature_map(), FeatureMap::StateBias { dim: 2 });
+        let v: [f64; 3] = policy.v().try_into().ok()?;
+        if !state_bias || policy.action_dim() != 1 {
+            return None;
+        }
+        let (sigma, inv_sigma) = policy.sigma_raw();
+        let stochastic = !policy.is_deterministic();
+        Some(FusedPolicy {
+            v,
+            sigma: if stochastic { sigma[0] } else { 0.0 },
+            inv_sigma: if stochastic { inv_sigma[0] } else { 0.0 },
+            stochastic,
+        })
+    }
+}
+
+/// One trajectory with the fused kernel when there is one (`fused`), else the generic kernel;
+/// both compute the same bits. Returns `(len, G)`; afterwards `sc.cum_v`, `sc.cum_w` hold the
+/// final cumulative scores.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn kernel<E: Environment + ?Sized, S: TrajSink>(
+    env: &E,
+    policy: &GaussianPolicy,
+    fused: Option<FusedPolicy>,
+    gamma: f64,
+    limit: usize,
+    rngs: &mut TrajectoryRngs,
+    sink: &mut S,
+    sc: &mut Scratch,
+) -> (usize, f64) {
+    match fused {
+        Some(p) => mountain_car_kernel(p, gamma, limit, rngs, sink, sc),
+        None => generic_kernel(env, policy, gamma, limit, rngs, sink, sc),
+    }
+}
+
+/// The generic kernel specialised to Mountain Car with state + bias features: the same
+/// floating-point operations in the same order (features, mean summed from the first feature,
+/// scores, [`crate::mountain_car`]'s transition), with the state and scores in registers.
+fn mountain_car_kernel<S: TrajSink>(
+    p: FusedPolicy,
+    gamma: f64,
+    limit: usize,
+    rngs: &mut TrajectoryRngs,
+    sink: &mut S,
+    sc: &mut Scratch,
+) -> (usize, f64) {
+    let mut state = [0.0; 2];
+    crate::mountain_car::reset(&mut rngs.env, &mut state);
+    let [mut pos, mut vel] = state;
+    let (mut cv, mut cw) = ([0.0; 3], [0.0; 1]);
+    let (mut disc, mut ret) = (1.0, 0.0);
+    let mut len = limit;
+    for t in 0..limit {
+        let phi = [pos, vel, 1.0];
+        let mu = p.v[0] * phi[0] + p.v[1] * phi[1] + p.v[2] * phi[2];
+        let a = if p.stochastic {
+            let z = standard_normal(&mut rngs.policy);
+            if S::SCORES {
+                let c = z * p.inv_sigma;
+                for (cvk, f) in cv.iter_mut().zip(phi) {
+                    *cvk += c * f;
+                }
+                cw[0] += z * z - 1.0;
+            }
+            mu + p.sigma * z
+        } else {
+            mu
+        };
+        let (next_pos, next_vel, r, done) = crate::mountain_car::transition(pos, vel, a);
+        let dr = disc * r;
+        sink.record(t, dr, &cv, &cw);
+        ret += dr;
+        disc *= gamma;
+        (pos, vel) = (next_pos, next_vel);
+        if done {
+            len = t + 1;
+            break;
+        }
+    }
+    sc.cum_v.copy_from_slice(&cv);
+    sc.cum_w.copy_from_slice(&cw);
+    (len, ret)
+}
+
 /// The generic kernel over any [`Environment`]. Returns `(len, G)`; stops after a terminal
 /// step.
 #[allow(clippy::too_many_arguments)]
@@ -816,6 +919,57 @@ mod tests {
     use crate::env::LqgEnv;
     use crate::lqg_model::LqgModel;
     use nalgebra::DVector;
+
+    /// The fused Mountain Car kernel and the generic kernel agree bit for bit: scored batches
+    /// (with terminations and padding) and returns of stochastic and deterministic policies.
+    #[test]
+    fn mountain_car_kernel_matches_generic_kernel() {
+        let env = crate::mountain_car::MountainCar::state_bias();
+        let key = SeedKey::new(8, 1, 2);
+        let (n, h) = (70, 300);
+        // Energy pumping (μ = 100·vel) terminates within the horizon; the other does not.
+        for (pi, terminates) in [
+            (
+                GaussianPolicy::new(vec![0.0, 100.0, 0.0], vec![-3.0], 3).unwrap(),
+                true,
+            ),
+            (
+                GaussianPolicy::new(vec![0.3, -2.0, 0.1], vec![-0.5], 3).unwrap(),
+                false,
+            ),
+        ] {
+            assert!(FusedPolicy::of(&env, &pi).is_some());
+            let fast = rollout(&env, &pi, n, h, key).unwrap();
+            assert_eq!(fast.steps() < n * h, terminates);
+            let mut slow = fast.clone();
+            fill_batch(
+                &mut slow,
+                key,
+                (2, 1, 3),
+                |rngs, rewards, score_v, score_w, sc| {
+                    let mut rows = TrajRows {
+                        rewards,
+                        score_v,
+                        score_w,
+                    };
+                    (
+                        generic_kernel(&env, &pi, 0.99, h, rngs, &mut rows, sc).0,
+                        true,
+                    )
+                },
+            );
+            assert_eq!(fast, slow);
+            for p in [pi.clone(), pi.to_deterministic()] {
+                let fast = rollout_returns(&env, &p, n, h, key).unwrap();
+                let mut sc = Scratch::new((2, 1, 3));
+                for (i, g) in fast.iter().enumerate() {
+                    let mut rngs = key.rngs(i as u64);
+                    let slow = generic_kernel(&env, &p, 0.99, h, &mut rngs, &mut NoSteps, &mut sc);
+                    assert_eq!(g.to_bits(), slow.1.to_bits());
+                }
+            }
+        }
+    }
 
     /// The fused scalar kernel and the generic kernel agree bit for bit on every scalar LQG
     /// variant (clipping on/off, noise on/off).

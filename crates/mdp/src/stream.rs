@@ -18,8 +18,8 @@ use crate::env::{Environment, ScalarLqg};
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix};
 use crate::rollout::{
-    LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, Scratch, TrajSink, check, generic_kernel,
-    scalar_kernel,
+    FusedPolicy, LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, Scratch, TrajSink, check,
+    kernel, scalar_kernel,
 };
 
 /// A per-step baseline for each v- and w-component: `v[t·dim_v + k]`, `w[t·dim_w + j]`.
@@ -61,6 +61,7 @@ pub(crate) struct Streamer<'a, E: Environment + ?Sized> {
     env: &'a E,
     policy: &'a GaussianPolicy,
     scalar: Option<(ScalarLqg, ScalarPolicy)>,
+    fused: Option<FusedPolicy>,
     gamma: f64,
     limit: usize,
     horizon: usize,
@@ -97,6 +98,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             env,
             policy,
             scalar,
+            fused: FusedPolicy::of(env, policy),
             gamma: env.gamma(),
             limit: env.time_limit().map_or(horizon, |tl| tl.min(horizon)),
             horizon,
@@ -157,9 +159,10 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                 let mut steps = 0;
                 for (k, g) in out.iter_mut().enumerate() {
                     let mut rngs = rngs_from_prefix(self.prefix, first + k as u64);
-                    let (len, ret) = generic_kernel(
+                    let (len, ret) = kernel(
                         self.env,
                         self.policy,
+                        self.fused,
                         self.gamma,
                         self.limit,
                         &mut rngs,
@@ -255,9 +258,10 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                 gv: &mut acc_v,
                 gw: &mut acc_w,
             };
-            let (len, g) = generic_kernel(
+            let (len, g) = kernel(
                 self.env,
                 self.policy,
+                self.fused,
                 self.gamma,
                 self.limit,
                 &mut rngs,
@@ -344,9 +348,10 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                 sums: &mut *sums,
                 last: (0.0, 0.0),
             };
-            let (len, _) = generic_kernel(
+            let (len, _) = kernel(
                 self.env,
                 self.policy,
+                self.fused,
                 self.gamma,
                 self.limit,
                 &mut rngs,
