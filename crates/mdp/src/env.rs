@@ -82,6 +82,11 @@ pub trait Environment: Sync {
     fn feature_dim(&self) -> usize;
     /// The constants used by the bounds.
     fn constants(&self) -> EnvConstants;
+    /// The discount factor `γ` of [`Environment::constants`], without computing the other
+    /// constants (`r_max` can take a search over the box corners).
+    fn gamma(&self) -> f64 {
+        self.constants().gamma
+    }
     /// A step limit after which an episode is truncated (not terminated), if any.
     fn time_limit(&self) -> Option<usize> {
         None
@@ -102,6 +107,11 @@ pub trait Environment: Sync {
     /// The scalar LQG behind this environment, if it is one: rollouts then run a fused
     /// specialised kernel with identical results.
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
+        None
+    }
+    /// The Mountain Car behind this environment, if it is one: with state + bias features,
+    /// rollouts then run a fused specialised kernel with identical results.
+    fn as_mountain_car(&self) -> Option<&MountainCar> {
         None
     }
 }
@@ -252,6 +262,10 @@ impl Environment for LqgEnv {
 
     fn feature_dim(&self) -> usize {
         self.n
+    }
+
+    fn gamma(&self) -> f64 {
+        self.model.gamma
     }
 
     fn constants(&self) -> EnvConstants {
@@ -444,6 +458,10 @@ impl Environment for AnyEnv {
         dispatch!(self, e => e.constants())
     }
 
+    fn gamma(&self) -> f64 {
+        dispatch!(self, e => e.gamma())
+    }
+
     fn time_limit(&self) -> Option<usize> {
         dispatch!(self, e => e.time_limit())
     }
@@ -468,5 +486,9 @@ impl Environment for AnyEnv {
 
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
         dispatch!(self, e => e.as_scalar_lqg())
+    }
+
+    fn as_mountain_car(&self) -> Option<&MountainCar> {
+        dispatch!(self, e => e.as_mountain_car())
     }
 }

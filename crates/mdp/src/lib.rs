@@ -19,6 +19,7 @@ pub mod oracle;
 pub mod policy;
 pub mod rng;
 pub mod rollout;
+mod stream;
 
 pub use batch::{Batch, BatchError};
 pub use env::{AnyEnv, EnvConstants, EnvError, Environment, LqgEnv, Preset};

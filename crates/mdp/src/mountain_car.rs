@@ -150,13 +150,16 @@ impl Environment for MountainCar {
         }
     }
 
+    fn gamma(&self) -> f64 {
+        self.gamma
+    }
+
     fn time_limit(&self) -> Option<usize> {
         Some(TIME_LIMIT)
     }
 
     fn reset(&self, rng: &mut TrajRng, state: &mut [f64]) {
-        state[0] = uniform(rng, -0.6, -0.4);
-        state[1] = 0.0;
+        reset(rng, state);
     }
 
     fn step(
@@ -166,24 +169,43 @@ impl Environment for MountainCar {
         _rng: &mut TrajRng,
         next: &mut [f64],
     ) -> (f64, bool) {
-        let (mut pos, mut vel) = (state[0], state[1]);
-        let a = action[0];
-        let force = a.clamp(-1.0, 1.0);
-        vel += force * POWER - 0.0025 * (3.0 * pos).cos();
-        vel = vel.clamp(-MAX_SPEED, MAX_SPEED);
-        pos += vel;
-        pos = pos.clamp(MIN_POSITION, MAX_POSITION);
-        if pos == MIN_POSITION && vel < 0.0 {
-            vel = 0.0;
-        }
-        let terminated = pos >= GOAL_POSITION && vel >= 0.0;
-        let reward = if terminated { 100.0 } else { 0.0 } - a * a * 0.1;
+        let (pos, vel, reward, terminated) = transition(state[0], state[1], action[0]);
         next[0] = pos;
         next[1] = vel;
         (reward, terminated)
     }
 
+    fn as_mountain_car(&self) -> Option<&MountainCar> {
+        Some(self)
+    }
+
     fn features(&self, state: &[f64], phi: &mut [f64]) {
         self.features.eval_unchecked(state, phi);
     }
+}
+
+/// One transition from `(pos, vel)` under the raw action `a` (the rules in the module
+/// documentation): `(pos′, vel′, reward, terminated)`. Shared by [`Environment::step`] and the
+/// fused rollout kernel, so both compute the same bits.
+#[inline(always)]
+pub(crate) fn transition(pos: f64, vel: f64, a: f64) -> (f64, f64, f64, bool) {
+    let (mut pos, mut vel) = (pos, vel);
+    let force = a.clamp(-1.0, 1.0);
+    vel += force * POWER - 0.0025 * (3.0 * pos).cos();
+    vel = vel.clamp(-MAX_SPEED, MAX_SPEED);
+    pos += vel;
+    pos = pos.clamp(MIN_POSITION, MAX_POSITION);
+    if pos == MIN_POSITION && vel < 0.0 {
+        vel = 0.0;
+    }
+    let terminated = pos >= GOAL_POSITION && vel >= 0.0;
+    let reward = if terminated { 100.0 } else { 0.0 } - a * a * 0.1;
+    (pos, vel, reward, terminated)
+}
+
+/// The initial state `(pos, vel) = (U[−0.6, −0.4), 0)` into `state` (length 2).
+#[inline(always)]
+pub(crate) fn reset(rng: &mut TrajRng, state: &mut [f64]) {
+    state[0] = uniform(rng, -0.6, -0.4);
+    state[1] = 0.0;
 }

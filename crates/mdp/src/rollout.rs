@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use crate::batch::Batch;
 use crate::env::{Environment, ScalarLqg};
+use crate::features::FeatureMap;
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uniform};
 
@@ -125,7 +126,7 @@ pub fn rollout_into<E: Environment + ?Sized>(
     let cells = n.checked_mul(horizon).ok_or(RolloutError::TooLarge)?;
     let cells_v = cells.checked_mul(dim_v).ok_or(RolloutError::TooLarge)?;
     let cells_w = cells.checked_mul(dim_w).ok_or(RolloutError::TooLarge)?;
-    let gamma = env.constants().gamma;
+    let gamma = env.gamma();
     batch.n = n;
     batch.horizon = horizon;
     batch.dim_v = dim_v;
@@ -139,21 +140,27 @@ pub fn rollout_into<E: Environment + ?Sized>(
     batch.lengths.resize(n, 0);
     let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
 
-    if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
+    let finite = if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
         let pol = ScalarPolicy {
             v: policy.v()[0],
             sigma: sigma[0],
             inv_sigma: inv_sigma[0],
         };
-        fill_batch_scalar(batch, key, p, pol, limit);
+        fill_batch_scalar(batch, key, p, pol, limit)
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
-        fill_batch(batch, key, dims, |rngs, rw, sv, sw, sc| {
-            generic_kernel::<E, true>(env, policy, gamma, limit, rngs, rw, sv, sw, sc).0
-        });
-    }
-    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
-    if finite(&batch.disc_rewards) && finite(&batch.cum_score_v) && finite(&batch.cum_score_w) {
+        let fused = FusedPolicy::of(env, policy);
+        fill_batch(batch, key, dims, |rngs, rewards, score_v, score_w, sc| {
+            let mut rows = TrajRows {
+                rewards,
+                score_v,
+                score_w,
+            };
+            let (len, g) = kernel(env, policy, fused, gamma, limit, rngs, &mut rows, sc);
+            (len, finite_trajectory(g, &sc.cum_v, &sc.cum_w))
+        })
+    };
+    if finite {
         Ok(())
     } else {
         Err(RolloutError::NonFinite)
@@ -213,7 +220,7 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
 ) -> Result<(), RolloutError> {
     check(env, policy, n, horizon)?;
     out.resize(n, 0.0);
-    let gamma = env.constants().gamma;
+    let gamma = env.gamma();
     let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
     let (sigma, inv_sigma) = policy.sigma_raw();
     if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
@@ -235,19 +242,9 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
         }
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
+        let fused = FusedPolicy::of(env, policy);
         fill_returns(out, key, dims, |rngs, sc| {
-            generic_kernel::<E, false>(
-                env,
-                policy,
-                gamma,
-                limit,
-                rngs,
-                &mut [],
-                &mut [],
-                &mut [],
-                sc,
-            )
-            .1
+            kernel(env, policy, fused, gamma, limit, rngs, &mut NoSteps, sc).1
         });
     }
     if out.iter().all(|x| x.is_finite()) {
@@ -311,7 +308,7 @@ pub fn evaluate_mean_policy<E: Environment + ?Sized>(
     mean_return(env, &policy.to_deterministic(), n, horizon, key)
 }
 
-fn check<E: Environment + ?Sized>(
+pub(crate) fn check<E: Environment + ?Sized>(
     env: &E,
     policy: &GaussianPolicy,
     n: usize,
@@ -335,18 +332,20 @@ fn check<E: Environment + ?Sized>(
     Ok(())
 }
 
-/// Per-chunk work buffers of the generic kernel.
-struct Scratch {
+/// Per-chunk work buffers of the generic kernel. After a trajectory, `cum_v` and `cum_w` hold
+/// its final cumulative scores.
+pub(crate) struct Scratch {
     state: Vec<f64>,
     next: Vec<f64>,
     phi: Vec<f64>,
     action: Vec<f64>,
-    cum_v: Vec<f64>,
-    cum_w: Vec<f64>,
+    pub(crate) cum_v: Vec<f64>,
+    pub(crate) cum_w: Vec<f64>,
 }
 
 impl Scratch {
-    fn new((n, l, p): (usize, usize, usize)) -> Self {
+    /// Buffers for `(state, action, feature)` dimensions `(n, l, p)`.
+    pub(crate) fn new((n, l, p): (usize, usize, usize)) -> Self {
         Scratch {
             state: vec![0.0; n],
             next: vec![0.0; n],
@@ -358,14 +357,116 @@ impl Scratch {
     }
 }
 
-/// Runs `kernel` for every trajectory of `batch` in parallel chunks and pads each trajectory
-/// after its length (rewards 0, cumulative scores frozen).
-fn fill_batch<F>(batch: &mut Batch, key: SeedKey, dims: (usize, usize, usize), kernel: F)
+/// What the generic kernel does with each step of a trajectory: `record(t, γ^t r_t, S^v_t,
+/// S^w_t)` with the cumulative scores after step `t` (only meaningful when `SCORES`).
+pub(crate) trait TrajSink {
+    /// Whether the kernel must accumulate the scores.
+    const SCORES: bool;
+    /// Step `t` of the trajectory.
+    fn record(&mut self, t: usize, dr: f64, cum_v: &[f64], cum_w: &[f64]);
+}
+
+/// Discards the steps (returns-only rollouts).
+pub(crate) struct NoSteps;
+
+impl TrajSink for NoSteps {
+    const SCORES: bool = false;
+    #[inline(always)]
+    fn record(&mut self, _: usize, _: f64, _: &[f64], _: &[f64]) {}
+}
+
+impl<const K: usize> LaneSink<K> for NoSteps {
+    const SCORES: bool = false;
+    #[inline(always)]
+    fn record(&mut self, _: usize, _: usize, _: f64, _: f64, _: f64) {}
+}
+
+/// Writes the steps into one trajectory's [`Batch`] rows.
+struct TrajRows<'a> {
+    rewards: &'a mut [f64],
+    score_v: &'a mut [f64],
+    score_w: &'a mut [f64],
+}
+
+impl TrajSink for TrajRows<'_> {
+    const SCORES: bool = true;
+    #[inline(always)]
+    fn record(&mut self, t: usize, dr: f64, cum_v: &[f64], cum_w: &[f64]) {
+        let (dv, l) = (cum_v.len(), cum_w.len());
+        self.rewards[t] = dr;
+        self.score_v[t * dv..(t + 1) * dv].copy_from_slice(cum_v);
+        self.score_w[t * l..(t + 1) * l].copy_from_slice(cum_w);
+    }
+}
+
+/// What the fused scalar kernel does with step `t` of lane `k`: `record(k, t, γ^t r_t, S^v_t,
+/// S^w_t)` (scores only meaningful when `SCORES`).
+pub(crate) trait LaneSink<const K: usize> {
+    /// Whether the kernel must accumulate the scores.
+    const SCORES: bool;
+    /// Step `t` of lane `k`.
+    fn record(&mut self, k: usize, t: usize, dr: f64, cv: f64, cw: f64);
+}
+
+/// Writes the steps into the [`Batch`] rows of `K` consecutive trajectories (rows of length
+/// `h` back to back).
+struct LaneRows<'a> {
+    rw: &'a mut [f64],
+    sv: &'a mut [f64],
+    sw: &'a mut [f64],
+    h: usize,
+}
+
+impl<const K: usize> LaneSink<K> for LaneRows<'_> {
+    const SCORES: bool = true;
+    #[inline(always)]
+    fn record(&mut self, k: usize, t: usize, dr: f64, cv: f64, cw: f64) {
+        let i = k * self.h + t;
+        self.rw[i] = dr;
+        self.sv[i] = cv;
+        self.sw[i] = cw;
+    }
+}
+
+/// Runs `kernel` for every trajectory of `batch` in parallel chunks (on the calling thread when
+/// there is a single chunk) and pads each trajectory after its length (rewards 0, cumulative
+/// scores frozen). `kernel` returns the length and whether the trajectory is finite; returns
+/// whether every trajectory is.
+fn fill_batch<F>(batch: &mut Batch, key: SeedKey, dims: (usize, usize, usize), kernel: F) -> bool
 where
-    F: Fn(&mut TrajectoryRngs, &mut [f64], &mut [f64], &mut [f64], &mut Scratch) -> usize + Sync,
+    F: Fn(&mut TrajectoryRngs, &mut [f64], &mut [f64], &mut [f64], &mut Scratch) -> (usize, bool)
+        + Sync,
 {
     let (h, dv, dw) = (batch.horizon, batch.dim_v, batch.dim_w);
     let prefix = key.prefix();
+    let body = |c: usize, rw: &mut [f64], sv: &mut [f64], sw: &mut [f64], lens: &mut [usize]| {
+        let mut scratch = Scratch::new(dims);
+        let trajectories = rw
+            .chunks_exact_mut(h)
+            .zip(sv.chunks_exact_mut(h * dv))
+            .zip(sw.chunks_exact_mut(h * dw))
+            .zip(lens.iter_mut());
+        let mut finite = true;
+        for (k, (((r, v), w), len)) in trajectories.enumerate() {
+            let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+            let (l, ok) = kernel(&mut rngs, r, v, w, &mut scratch);
+            pad(r, v, dv, l);
+            pad_scores(w, dw, l);
+            *len = l;
+            finite &= ok;
+        }
+        finite
+    };
+    if batch.n <= CHUNK {
+        let b = batch;
+        return body(
+            0,
+            &mut b.disc_rewards,
+            &mut b.cum_score_v,
+            &mut b.cum_score_w,
+            &mut b.lengths,
+        );
+    }
     batch
         .disc_rewards
         .par_chunks_mut(CHUNK * h)
@@ -373,21 +474,16 @@ where
         .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h * dw))
         .zip(batch.lengths.par_chunks_mut(CHUNK))
         .enumerate()
-        .for_each(|(c, (((rw, sv), sw), lens))| {
-            let mut scratch = Scratch::new(dims);
-            let trajectories = rw
-                .chunks_exact_mut(h)
-                .zip(sv.chunks_exact_mut(h * dv))
-                .zip(sw.chunks_exact_mut(h * dw))
-                .zip(lens.iter_mut());
-            for (k, (((r, v), w), len)) in trajectories.enumerate() {
-                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
-                let l = kernel(&mut rngs, r, v, w, &mut scratch);
-                pad(r, v, dv, l);
-                pad_scores(w, dw, l);
-                *len = l;
-            }
-        });
+        .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
+        .reduce(|| true, |a, b| a & b)
+}
+
+/// Whether a trajectory with return `g` and final cumulative scores `cum_v`, `cum_w` has only
+/// finite rewards and scores: a running sum that meets ±∞ or NaN never becomes finite again,
+/// so checking the sums checks every term.
+#[inline]
+fn finite_trajectory(g: f64, cum_v: &[f64], cum_w: &[f64]) -> bool {
+    g.is_finite() && cum_v.iter().chain(cum_w).all(|x| x.is_finite())
 }
 
 /// Zero rewards from `len` on, freeze the v-scores at their last value.
@@ -412,34 +508,40 @@ fn pad_scores(scores: &mut [f64], dim: usize, len: usize) {
     }
 }
 
-/// Runs `kernel` for every trajectory in parallel chunks, storing its discounted return.
+/// Runs `kernel` for every trajectory in parallel chunks (on the calling thread when there is
+/// a single chunk), storing its discounted return.
 fn fill_returns<F>(out: &mut [f64], key: SeedKey, dims: (usize, usize, usize), kernel: F)
 where
     F: Fn(&mut TrajectoryRngs, &mut Scratch) -> f64 + Sync,
 {
     let prefix = key.prefix();
-    out.par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, chunk)| {
-            let mut scratch = Scratch::new(dims);
-            for (k, g) in chunk.iter_mut().enumerate() {
-                let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
-                *g = kernel(&mut rngs, &mut scratch);
-            }
-        });
+    let body = |c: usize, chunk: &mut [f64]| {
+        let mut scratch = Scratch::new(dims);
+        for (k, g) in chunk.iter_mut().enumerate() {
+            let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
+            *g = kernel(&mut rngs, &mut scratch);
+        }
+    };
+    if out.len() <= CHUNK {
+        body(0, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| body(c, chunk));
+    }
 }
 
 /// Trajectories advanced in lockstep by the fused scalar kernel. Each trajectory is a serial
 /// chain of dependent floating-point operations; interleaving independent trajectories lets
 /// the CPU overlap their latencies. The arithmetic of each trajectory is unchanged.
-const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 
 /// Mean gain and noise scale of a one-feature, one-action policy.
 #[derive(Clone, Copy)]
-struct ScalarPolicy {
-    v: f64,
-    sigma: f64,
-    inv_sigma: f64,
+pub(crate) struct ScalarPolicy {
+    pub(crate) v: f64,
+    pub(crate) sigma: f64,
+    pub(crate) inv_sigma: f64,
 }
 
 /// [`fill_batch`] for the scalar LQG, running the fused kernel on groups of [`LANES`]
@@ -450,9 +552,47 @@ fn fill_batch_scalar(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
-) {
+) -> bool {
     let h = batch.horizon;
     let prefix = key.prefix();
+    let body = |c: usize, rw: &mut [f64], sv: &mut [f64], sw: &mut [f64], lens: &mut [usize]| {
+        let groups = rw
+            .chunks_mut(LANES * h)
+            .zip(sv.chunks_mut(LANES * h))
+            .zip(sw.chunks_mut(LANES * h))
+            .zip(lens.chunks_mut(LANES));
+        let mut finite = true;
+        for (g, (((r, v), w), ls)) in groups.enumerate() {
+            let first = (c * CHUNK + g * LANES) as u64;
+            if ls.len() == LANES {
+                finite &= scalar_group::<LANES>(p, pol, limit, prefix, first, r, v, w, h);
+            } else {
+                for k in 0..ls.len() {
+                    let span = k * h..(k + 1) * h;
+                    let (rk, vk, wk) = (&mut r[span.clone()], &mut v[span.clone()], &mut w[span]);
+                    finite &=
+                        scalar_group::<1>(p, pol, limit, prefix, first + k as u64, rk, vk, wk, h);
+                }
+            }
+            for (k, len) in ls.iter_mut().enumerate() {
+                let span = k * h..(k + 1) * h;
+                pad(&mut r[span.clone()], &mut v[span.clone()], 1, limit);
+                pad_scores(&mut w[span], 1, limit);
+                *len = limit;
+            }
+        }
+        finite
+    };
+    if batch.n <= CHUNK {
+        let b = batch;
+        return body(
+            0,
+            &mut b.disc_rewards,
+            &mut b.cum_score_v,
+            &mut b.cum_score_w,
+            &mut b.lengths,
+        );
+    }
     batch
         .disc_rewards
         .par_chunks_mut(CHUNK * h)
@@ -460,36 +600,13 @@ fn fill_batch_scalar(
         .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h))
         .zip(batch.lengths.par_chunks_mut(CHUNK))
         .enumerate()
-        .for_each(|(c, (((rw, sv), sw), lens))| {
-            let groups = rw
-                .chunks_mut(LANES * h)
-                .zip(sv.chunks_mut(LANES * h))
-                .zip(sw.chunks_mut(LANES * h))
-                .zip(lens.chunks_mut(LANES));
-            for (g, (((r, v), w), ls)) in groups.enumerate() {
-                let first = (c * CHUNK + g * LANES) as u64;
-                if ls.len() == LANES {
-                    scalar_group::<LANES>(p, pol, limit, prefix, first, r, v, w, h);
-                } else {
-                    for k in 0..ls.len() {
-                        let span = k * h..(k + 1) * h;
-                        let (rk, vk, wk) =
-                            (&mut r[span.clone()], &mut v[span.clone()], &mut w[span]);
-                        scalar_group::<1>(p, pol, limit, prefix, first + k as u64, rk, vk, wk, h);
-                    }
-                }
-                for (k, len) in ls.iter_mut().enumerate() {
-                    let span = k * h..(k + 1) * h;
-                    pad(&mut r[span.clone()], &mut v[span.clone()], 1, limit);
-                    pad_scores(&mut w[span], 1, limit);
-                    *len = limit;
-                }
-            }
-        });
+        .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
+        .reduce(|| true, |a, b| a & b)
 }
 
 /// Runs the scored scalar kernel on `K` consecutive trajectories whose rows are consecutive in
-/// `r`, `v`, `w` (each of length `K · h`).
+/// `r`, `v`, `w` (each of length `K · h`); returns whether they are all finite
+/// ([`finite_trajectory`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn scalar_group<const K: usize>(
@@ -502,10 +619,19 @@ fn scalar_group<const K: usize>(
     v: &mut [f64],
     w: &mut [f64],
     h: usize,
-) {
+) -> bool {
     let mut rngs: [TrajectoryRngs; K] =
         std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-    scalar_kernel::<K, true, true>(p, pol, limit, &mut rngs, [r, v, w], h);
+    let limit = limit.min(h);
+    let mut rows = LaneRows {
+        rw: &mut r[..K * h],
+        sv: &mut v[..K * h],
+        sw: &mut w[..K * h],
+        h,
+    };
+    let g = scalar_kernel::<K, _, true>(p, pol, limit, &mut rngs, &mut rows);
+    let last = limit - 1;
+    (0..K).all(|k| finite_trajectory(g[k], &v[k * h + last..][..1], &w[k * h + last..][..1]))
 }
 
 /// [`fill_returns`] for the scalar LQG (`STOCH = false`: the deterministic policy).
@@ -517,50 +643,51 @@ fn fill_returns_scalar<const STOCH: bool>(
     limit: usize,
 ) {
     let prefix = key.prefix();
-    out.par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, chunk)| {
-            for (g, group) in chunk.chunks_mut(LANES).enumerate() {
-                let first = (c * CHUNK + g * LANES) as u64;
-                if group.len() == LANES {
-                    let mut rngs: [TrajectoryRngs; LANES] =
-                        std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-                    group.copy_from_slice(&scalar_kernel::<LANES, false, STOCH>(
-                        p,
-                        pol,
-                        limit,
-                        &mut rngs,
-                        [&mut [], &mut [], &mut []],
-                        0,
-                    ));
-                } else {
-                    for (k, g) in group.iter_mut().enumerate() {
-                        let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
-                        let rows = [&mut [][..], &mut [], &mut []];
-                        *g = scalar_kernel::<1, false, STOCH>(p, pol, limit, &mut rngs, rows, 0)[0];
-                    }
+    let body = |c: usize, chunk: &mut [f64]| {
+        for (g, group) in chunk.chunks_mut(LANES).enumerate() {
+            let first = (c * CHUNK + g * LANES) as u64;
+            if group.len() == LANES {
+                let mut rngs: [TrajectoryRngs; LANES] =
+                    std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
+                group.copy_from_slice(&scalar_kernel::<LANES, _, STOCH>(
+                    p,
+                    pol,
+                    limit,
+                    &mut rngs,
+                    &mut NoSteps,
+                ));
+            } else {
+                for (k, g) in group.iter_mut().enumerate() {
+                    let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
+                    *g = scalar_kernel::<1, _, STOCH>(p, pol, limit, &mut rngs, &mut NoSteps)[0];
                 }
             }
-        });
+        }
+    };
+    if out.len() <= CHUNK {
+        body(0, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| body(c, chunk));
+    }
 }
 
-/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep.
-/// `rows = [rewards, cum v-scores, cum w-scores]`, each holding the `K` trajectories' rows of
-/// length `h ≥ limit` back to back (written only when `SCORES`). `STOCH = false` is the
-/// deterministic policy (no draws from the policy stream). Returns the discounted returns.
+/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep,
+/// for `limit` steps; every step goes to `sink`. `STOCH = false` is the deterministic policy
+/// (no draws from the policy stream). Returns the discounted returns.
 #[inline(always)]
-fn scalar_kernel<const K: usize, const SCORES: bool, const STOCH: bool>(
+pub(crate) fn scalar_kernel<const K: usize, S: LaneSink<K>, const STOCH: bool>(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
     rngs: &mut [TrajectoryRngs; K],
-    rows: [&mut [f64]; 3],
-    h: usize,
+    sink: &mut S,
 ) -> [f64; K] {
     if p.clipping {
-        scalar_kernel_impl::<K, SCORES, STOCH, true>(p, pol, limit, rngs, rows, h)
+        scalar_kernel_impl::<K, S, STOCH, true>(p, pol, limit, rngs, sink)
     } else {
-        scalar_kernel_impl::<K, SCORES, STOCH, false>(p, pol, limit, rngs, rows, h)
+        scalar_kernel_impl::<K, S, STOCH, false>(p, pol, limit, rngs, sink)
     }
 }
 
@@ -568,13 +695,12 @@ fn scalar_kernel<const K: usize, const SCORES: bool, const STOCH: bool>(
 /// lanes' variates (policy stream, then environment stream, in the same per-stream order as
 /// the generic kernel), then runs the short branch-free arithmetic over the lanes.
 #[inline(always)]
-fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, const CLIP: bool>(
+fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const CLIP: bool>(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
     rngs: &mut [TrajectoryRngs; K],
-    rows: [&mut [f64]; 3],
-    h: usize,
+    sink: &mut S,
 ) -> [f64; K] {
     let p = *p;
     let ScalarPolicy {
@@ -586,13 +712,6 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
     let mut s: [f64; K] =
         std::array::from_fn(|k| uniform(&mut rngs[k].env, p.init_low, p.init_high));
     let (mut cv, mut cw, mut ret) = ([0.0; K], [0.0; K], [0.0; K]);
-    let [rw, sv, sw] = rows;
-    let (rw, sv, sw, limit) = if SCORES {
-        let limit = limit.min(h);
-        (&mut rw[..K * h], &mut sv[..K * h], &mut sw[..K * h], limit)
-    } else {
-        (rw, sv, sw, limit)
-    };
     let mut disc = 1.0;
     let (mut z, mut eta) = ([0.0; K], [0.0; K]);
     for t in 0..limit {
@@ -611,7 +730,7 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
             let mu = v * sk;
             let a = if STOCH {
                 let zk = z[k];
-                if SCORES {
+                if S::SCORES {
                     cv[k] += zk * inv_sigma * sk;
                     cw[k] += zk * zk - 1.0;
                 }
@@ -626,11 +745,7 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
             };
             let r = -(sk * (p.q * sk) + ac * (p.r * ac));
             let dr = disc * r;
-            if SCORES {
-                rw[k * h + t] = dr;
-                sv[k * h + t] = cv[k];
-                sw[k * h + t] = cw[k];
-            }
+            sink.record(k, t, dr, cv[k], cw[k]);
             ret[k] += dr;
             let mut x = p.a * sk + p.b * ac;
             if noisy {
@@ -647,25 +762,122 @@ fn scalar_kernel_impl<const K: usize, const SCORES: bool, const STOCH: bool, con
     ret
 }
 
+/// The policy of a rollout that runs a fused kernel instead of the generic one: Mountain Car
+/// with state + bias features (`φ = [pos, vel, 1]`, one action).
+#[derive(Clone, Copy)]
+pub(crate) struct FusedPolicy {
+    v: [f64; 3],
+    sigma: f64,
+    inv_sigma: f64,
+    stochastic: bool,
+}
+
+impl FusedPolicy {
+    /// The fused Mountain Car policy, if `env` and `policy` have that shape.
+    pub(crate) fn of<E: Environment + ?Sized>(env: &E, policy: &GaussianPolicy) -> Option<Self> {
+        let mc = env.as_mountain_car()?;
+        let state_bias = matches!(mc.feature_map(), FeatureMap::StateBias { dim: 2 });
+        let v: [f64; 3] = policy.v().try_into().ok()?;
+        if !state_bias || policy.action_dim() != 1 {
+            return None;
+        }
+        let (sigma, inv_sigma) = policy.sigma_raw();
+        let stochastic = !policy.is_deterministic();
+        Some(FusedPolicy {
+            v,
+            sigma: if stochastic { sigma[0] } else { 0.0 },
+            inv_sigma: if stochastic { inv_sigma[0] } else { 0.0 },
+            stochastic,
+        })
+    }
+}
+
+/// One trajectory with the fused kernel when there is one (`fused`), else the generic kernel;
+/// both compute the same bits. Returns `(len, G)`; afterwards `sc.cum_v`, `sc.cum_w` hold the
+/// final cumulative scores.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn kernel<E: Environment + ?Sized, S: TrajSink>(
+    env: &E,
+    policy: &GaussianPolicy,
+    fused: Option<FusedPolicy>,
+    gamma: f64,
+    limit: usize,
+    rngs: &mut TrajectoryRngs,
+    sink: &mut S,
+    sc: &mut Scratch,
+) -> (usize, f64) {
+    match fused {
+        Some(p) => mountain_car_kernel(p, gamma, limit, rngs, sink, sc),
+        None => generic_kernel(env, policy, gamma, limit, rngs, sink, sc),
+    }
+}
+
+/// The generic kernel specialised to Mountain Car with state + bias features: the same
+/// floating-point operations in the same order (features, mean summed from the first feature,
+/// scores, [`crate::mountain_car`]'s transition), with the state and scores in registers.
+fn mountain_car_kernel<S: TrajSink>(
+    p: FusedPolicy,
+    gamma: f64,
+    limit: usize,
+    rngs: &mut TrajectoryRngs,
+    sink: &mut S,
+    sc: &mut Scratch,
+) -> (usize, f64) {
+    let mut state = [0.0; 2];
+    crate::mountain_car::reset(&mut rngs.env, &mut state);
+    let [mut pos, mut vel] = state;
+    let (mut cv, mut cw) = ([0.0; 3], [0.0; 1]);
+    let (mut disc, mut ret) = (1.0, 0.0);
+    let mut len = limit;
+    for t in 0..limit {
+        let phi = [pos, vel, 1.0];
+        let mu = p.v[0] * phi[0] + p.v[1] * phi[1] + p.v[2] * phi[2];
+        let a = if p.stochastic {
+            let z = standard_normal(&mut rngs.policy);
+            if S::SCORES {
+                let c = z * p.inv_sigma;
+                for (cvk, f) in cv.iter_mut().zip(phi) {
+                    *cvk += c * f;
+                }
+                cw[0] += z * z - 1.0;
+            }
+            mu + p.sigma * z
+        } else {
+            mu
+        };
+        let (next_pos, next_vel, r, done) = crate::mountain_car::transition(pos, vel, a);
+        let dr = disc * r;
+        sink.record(t, dr, &cv, &cw);
+        ret += dr;
+        disc *= gamma;
+        (pos, vel) = (next_pos, next_vel);
+        if done {
+            len = t + 1;
+            break;
+        }
+    }
+    sc.cum_v.copy_from_slice(&cv);
+    sc.cum_w.copy_from_slice(&cw);
+    (len, ret)
+}
+
 /// The generic kernel over any [`Environment`]. Returns `(len, G)`; stops after a terminal
 /// step.
 #[allow(clippy::too_many_arguments)]
-fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
+pub(crate) fn generic_kernel<E: Environment + ?Sized, S: TrajSink>(
     env: &E,
     policy: &GaussianPolicy,
     gamma: f64,
     limit: usize,
     rngs: &mut TrajectoryRngs,
-    rewards: &mut [f64],
-    score_v: &mut [f64],
-    score_w: &mut [f64],
+    sink: &mut S,
     sc: &mut Scratch,
 ) -> (usize, f64) {
     let (sigma, inv_sigma) = policy.sigma_raw();
     let stochastic = !policy.is_deterministic();
     let p = policy.feature_dim();
     let l = policy.action_dim();
-    let dv = l * p;
     env.reset(&mut rngs.env, &mut sc.state);
     sc.cum_v.fill(0.0);
     sc.cum_w.fill(0.0);
@@ -676,7 +888,7 @@ fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
             let mu = policy.mean_j(&sc.phi, j);
             sc.action[j] = if stochastic {
                 let z = standard_normal(&mut rngs.policy);
-                if SCORES {
+                if S::SCORES {
                     let c = z * inv_sigma[j];
                     for (cv, f) in sc.cum_v[j * p..(j + 1) * p].iter_mut().zip(&sc.phi) {
                         *cv += c * f;
@@ -690,11 +902,7 @@ fn generic_kernel<E: Environment + ?Sized, const SCORES: bool>(
         }
         let (r, done) = env.step(&sc.state, &sc.action, &mut rngs.env, &mut sc.next);
         let dr = disc * r;
-        if SCORES {
-            rewards[t] = dr;
-            score_v[t * dv..(t + 1) * dv].copy_from_slice(&sc.cum_v);
-            score_w[t * l..(t + 1) * l].copy_from_slice(&sc.cum_w);
-        }
+        sink.record(t, dr, &sc.cum_v, &sc.cum_w);
         ret += dr;
         disc *= gamma;
         std::mem::swap(&mut sc.state, &mut sc.next);
@@ -711,6 +919,57 @@ mod tests {
     use crate::env::LqgEnv;
     use crate::lqg_model::LqgModel;
     use nalgebra::DVector;
+
+    /// The fused Mountain Car kernel and the generic kernel agree bit for bit: scored batches
+    /// (with terminations and padding) and returns of stochastic and deterministic policies.
+    #[test]
+    fn mountain_car_kernel_matches_generic_kernel() {
+        let env = crate::mountain_car::MountainCar::state_bias();
+        let key = SeedKey::new(8, 1, 2);
+        let (n, h) = (70, 300);
+        // Energy pumping (μ = 100·vel) terminates within the horizon; the other does not.
+        for (pi, terminates) in [
+            (
+                GaussianPolicy::new(vec![0.0, 100.0, 0.0], vec![-3.0], 3).unwrap(),
+                true,
+            ),
+            (
+                GaussianPolicy::new(vec![0.3, -2.0, 0.1], vec![-0.5], 3).unwrap(),
+                false,
+            ),
+        ] {
+            assert!(FusedPolicy::of(&env, &pi).is_some());
+            let fast = rollout(&env, &pi, n, h, key).unwrap();
+            assert_eq!(fast.steps() < n * h, terminates);
+            let mut slow = fast.clone();
+            fill_batch(
+                &mut slow,
+                key,
+                (2, 1, 3),
+                |rngs, rewards, score_v, score_w, sc| {
+                    let mut rows = TrajRows {
+                        rewards,
+                        score_v,
+                        score_w,
+                    };
+                    (
+                        generic_kernel(&env, &pi, 0.99, h, rngs, &mut rows, sc).0,
+                        true,
+                    )
+                },
+            );
+            assert_eq!(fast, slow);
+            for p in [pi.clone(), pi.to_deterministic()] {
+                let fast = rollout_returns(&env, &p, n, h, key).unwrap();
+                let mut sc = Scratch::new((2, 1, 3));
+                for (i, g) in fast.iter().enumerate() {
+                    let mut rngs = key.rngs(i as u64);
+                    let slow = generic_kernel(&env, &p, 0.99, h, &mut rngs, &mut NoSteps, &mut sc);
+                    assert_eq!(g.to_bits(), slow.1.to_bits());
+                }
+            }
+        }
+    }
 
     /// The fused scalar kernel and the generic kernel agree bit for bit on every scalar LQG
     /// variant (clipping on/off, noise on/off).
@@ -734,10 +993,23 @@ mod tests {
             let env = LqgEnv::new(model).unwrap();
             let fast = rollout(&env, &pi, n, h, key).unwrap();
             let mut slow = fast.clone();
-            let gamma = env.constants().gamma;
-            fill_batch(&mut slow, key, (1, 1, 1), |rngs, rw, sv, sw, sc| {
-                generic_kernel::<LqgEnv, true>(&env, &pi, gamma, h, rngs, rw, sv, sw, sc).0
-            });
+            let gamma = env.gamma();
+            fill_batch(
+                &mut slow,
+                key,
+                (1, 1, 1),
+                |rngs, rewards, score_v, score_w, sc| {
+                    let mut rows = TrajRows {
+                        rewards,
+                        score_v,
+                        score_w,
+                    };
+                    (
+                        generic_kernel(&env, &pi, gamma, h, rngs, &mut rows, sc).0,
+                        true,
+                    )
+                },
+            );
             assert_eq!(fast, slow);
             let fast_g = rollout_returns(&env, &pi, n, h, key).unwrap();
             let det = pi.to_deterministic();
@@ -745,32 +1017,10 @@ mod tests {
             for i in 0..n {
                 let mut sc = Scratch::new((1, 1, 1));
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel::<LqgEnv, false>(
-                    &env,
-                    &pi,
-                    gamma,
-                    h,
-                    &mut rngs,
-                    &mut [],
-                    &mut [],
-                    &mut [],
-                    &mut sc,
-                )
-                .1;
+                let g = generic_kernel(&env, &pi, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_g[i].to_bits());
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel::<LqgEnv, false>(
-                    &env,
-                    &det,
-                    gamma,
-                    h,
-                    &mut rngs,
-                    &mut [],
-                    &mut [],
-                    &mut [],
-                    &mut sc,
-                )
-                .1;
+                let g = generic_kernel(&env, &det, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_det[i].to_bits());
             }
         }

@@ -10,10 +10,11 @@
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 use sepg_mdp::env::LqgEnv;
 use sepg_mdp::lqg_model::LqgModel;
+use sepg_mdp::monte_carlo::stream_returns;
 use sepg_mdp::oracle::{ClippedDpOracle, ExactOracle, Horizon};
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
-use sepg_mdp::rollout::{rollout, rollout_returns};
+use sepg_mdp::rollout::rollout;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const N: usize = 1_000_000;
@@ -37,6 +38,10 @@ fn mean_se(x: &[f64]) -> (f64, f64) {
 
 fn check(label: &str, samples: &[f64], exact: f64) {
     let (m, se) = mean_se(samples);
+    check_mean(label, m, se, exact);
+}
+
+fn check_mean(label: &str, m: f64, se: f64, exact: f64) {
     let z = z_crit();
     println!(
         "{label}: exact {exact:.6}, MC {m:.6} ± {se:.2e} ({:+.2} SE)",
@@ -105,10 +110,11 @@ fn dp_values_agree_with_monte_carlo() {
         };
         let exact = oracle.evaluate_policy(&policy, Horizon::Finite(H)).unwrap();
         let key = SeedKey::new(seeds.next_u64(), 0, 0);
-        let returns = rollout_returns(&env, &policy, N, H, key).unwrap();
-        check(
+        let (returns, _) = stream_returns(&env, &policy, N, H, key).unwrap();
+        check_mean(
             &format!("J r_max={} v={v} σ={sigma:?}", model.r_max()),
-            &returns,
+            returns.mean(),
+            returns.std_error(),
             exact.j,
         );
     }

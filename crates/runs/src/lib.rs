@@ -14,12 +14,15 @@
 //! spec, folder          options and their resolution; the files of a run folder
 //! ```
 //!
+//! [`estimate`] (streamed Monte Carlo estimates of one policy) stands alone.
+//!
 //! [`audit`] sits beside them: it reads a run folder ([`folder`], [`spec`]) and re-checks its
 //! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
 //! [`Error`]; nothing here prints.
 
 pub mod audit;
 pub mod error;
+pub mod estimate;
 pub mod figure;
 pub mod folder;
 pub mod merge;
