@@ -410,6 +410,7 @@ impl RunSpec {
             iterations: schedule.iterations,
             seed: schedule.seed,
             initial_budget: start.budget0,
+            options: Default::default(),
         };
         let checked = config
             .check()

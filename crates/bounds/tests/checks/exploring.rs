@@ -35,8 +35,14 @@ fn zero_width_is_theorem_4_5() {
                             }
                         }
                         (
-                            StepOutcome::Infeasible { c_max: a, vertex: v },
-                            StepOutcome::Infeasible { c_max: b, vertex: w },
+                            StepOutcome::Infeasible {
+                                c_max: a,
+                                vertex: v,
+                            },
+                            StepOutcome::Infeasible {
+                                c_max: b,
+                                vertex: w,
+                            },
                         ) => assert!(close(a, b, 1e-12) && close(v, w, 1e-12)),
                         (a, b) => panic!("{a:?} vs {b:?} at g = {g}, l = {l}, C = {required}"),
                     }
@@ -118,8 +124,8 @@ fn below_noise_surrogate_still_explores() {
     // The situation of most w-blocks of a sampled run: |∇̂_w L| ≤ ε_L, budget available.
     for k in presets() {
         let required = -1e-4;
-        let thesis = w_safe_step_along_l(&k, 1.0, -0.3, 0.1, 0.4, 0.5, required, HpForm::SignAware)
-            .unwrap();
+        let thesis =
+            w_safe_step_along_l(&k, 1.0, -0.3, 0.1, 0.4, 0.5, required, HpForm::SignAware).unwrap();
         assert_eq!(thesis, StepOutcome::BelowNoise);
         let beta = w_exploring_step(&k, 1.0, -0.3, 0.1, 0.4, required)
             .unwrap()
