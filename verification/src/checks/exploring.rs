@@ -148,8 +148,11 @@ pub(crate) fn checks() -> Vec<Check> {
         cross-fitted ∇̂_w L, t-widths at δ = 0.2, C ∈ {0, −C_max^w/10, −C_max^w} with the exact \
         C_max^w = (∇_w J)²/(4d); independent batches (one per case)"
         .into();
-    m.notes = "Holds: no realised violation; the figures count the batches where Theorem 4.9 \
-        makes no update (|∇̂_w L| ≤ ε_L) and the exploring step moves."
+    m.notes = "Holds: realised violation rates at most 0.045 (lqg1d, C = −C_max^w/10; 90 of \
+        2000 batches) against δ = 0.2, 0.0105 on lqg, 0 for C = 0; the exploring step is never \
+        shorter along ∇̂_w L than Theorem 4.9's. Theorem 4.9 makes no update in 78% (lqg) and \
+        82% (lqg1d) of the batches; there the exploring step moves in every batch with C < 0 and \
+        in about a third to a half of them with C = 0 (full run, seed 0)."
         .into();
     vec![Check::new(m, exploring_w_step)]
 }
