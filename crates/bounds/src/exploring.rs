@@ -18,7 +18,8 @@
 //! data, in particular along the sign of an estimate ∇̂_w L from the same batch, inherits it:
 //! ∇̂_w L only picks the direction and its confidence width ε_L plays no role in safety.
 //! Theorem 4.9 instead multiplies corrected norms L⁻J⁻ and skips the update whenever
-//! |∇̂_w L| ≤ ε_L, which blocks exploration without making the step any safer (ERRATA §26).
+//! |∇̂_w L| ≤ ε_L, which blocks exploration without making the step any safer
+//! (docs/ERRATA.md, "Theorem 4.9 is needlessly conservative").
 //!
 //! B is concave, so {Δw : B(Δw) ≥ C} is an interval; the exploring step is the end of that
 //! interval furthest along ∇̂_w L, which is the thesis's β̄ = β̃ + λ_w|β̃| (eq. (4.20)) when
