@@ -440,3 +440,43 @@ pub fn run(
     };
     Ok((file, stats))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thesis-code setting reaches the SEPG variants (alternating and LB-I's full
+    /// requirement only where they apply), the baseline fit reaches every variant, and a flag
+    /// overrides the setting.
+    #[test]
+    fn settings_reach_the_variants_they_apply_to() {
+        let opts = ReproduceOptions {
+            setting: Setting::ThesisCode,
+            flags: OptionFlags {
+                confidence: Some(ConfidenceName::StudentT),
+                ..OptionFlags::default()
+            },
+            ..ReproduceOptions::new(Experiment::Table51)
+        };
+        let spec = sweep_spec(&opts).expect("valid");
+        let by_name = |n: &str| {
+            spec.variant
+                .iter()
+                .find(|v| v.name.as_deref() == Some(n))
+                .expect("variant")
+        };
+        let (lb1, zv, adam) = (by_name("lb1"), by_name("zv"), by_name("adam-1e-4"));
+        assert_eq!(lb1.alternating, Some(true));
+        assert_eq!(lb1.lb1_requirement, Some(Lb1Name::Full));
+        assert_eq!(zv.alternating, None);
+        assert_eq!(zv.w_direction, Some(WDirectionName::Metagradient));
+        assert_eq!(zv.confidence, Some(ConfidenceName::StudentT));
+        assert_eq!(adam.w_direction, None);
+        assert_eq!(adam.baseline_fit, Some(FitName::PlugIn));
+        let (_, resolved) = crate::sweep::expand(&spec, crate::sweep::Shard { index: 0, count: 1 })
+            .expect("every run resolves");
+        assert_eq!(resolved.len(), 880);
+        let default = sweep_spec(&ReproduceOptions::new(Experiment::Table51)).expect("valid");
+        assert!(default.variant.iter().all(|v| v.w_direction.is_none()));
+    }
+}

@@ -1082,6 +1082,103 @@ mod tests {
         assert!(spec.resolve().is_err());
     }
 
+    /// Every SEPG option reaches the algorithm's configuration, is written back into the
+    /// resolved specification, and survives a round trip through config.toml.
+    #[test]
+    fn sepg_options_resolve_and_round_trip() {
+        let spec = RunSpec {
+            env: Some(EnvName::Lqg1d),
+            algo: Some(AlgoName::SepgLb1),
+            w_step: Some(WStepName::Theorem49),
+            w_direction: Some(WDirectionName::Metagradient),
+            metagradient_clip: Some(50.0),
+            confidence: Some(ConfidenceName::StudentT),
+            quantile_factor: Some(2.0),
+            lb1_requirement: Some(Lb1Name::Full),
+            alternating: Some(true),
+            reference_batch: Some(0),
+            gamma: Some(0.9),
+            r_max: Some(30.0),
+            ..RunSpec::default()
+        };
+        let once = spec.resolve().expect("valid");
+        let o = once.checked.config().options;
+        assert_eq!(o.w_step, WStep::Theorem49);
+        assert_eq!(o.w_direction, WDirection::Metagradient { clip: 50.0 });
+        assert_eq!(o.confidence, Confidence::StudentT { factor: 2.0 });
+        assert_eq!(o.lb1_requirement, Lb1Requirement::Full);
+        assert!(o.alternating);
+        assert_eq!(o.reference_batch, 0);
+        assert_eq!(once.checked.constants().gamma(), 0.9);
+        assert_eq!(once.checked.constants().r_max(), 30.0);
+        assert_eq!(once.spec.m_phi, None);
+        let text = once.toml().expect("toml");
+        assert!(
+            text.contains("w-step = \"theorem-4.9\"") && text.contains("quantile-factor = 2.0")
+        );
+        let again: RunSpec = toml::from_str(&text).expect("parse");
+        let twice = again.resolve().expect("valid");
+        assert_eq!(once.spec, twice.spec);
+        assert_eq!(once.checked, twice.checked);
+        // The defaults are written out too.
+        let plain = RunSpec {
+            algo: Some(AlgoName::SepgZv),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid");
+        assert_eq!(plain.spec.w_step, Some(WStepName::Exploring));
+        assert_eq!(plain.spec.confidence, Some(ConfidenceName::StudentT));
+        assert_eq!(plain.spec.reference_batch, Some(1000));
+        assert_eq!(plain.spec.lb1_requirement, None);
+    }
+
+    #[test]
+    fn sepg_options_that_do_not_apply_are_rejected() {
+        let bad = [
+            RunSpec {
+                algo: Some(AlgoName::GpomdpAdam),
+                lr: Some(1e-3),
+                w_step: Some(WStepName::Exploring),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                lb1_requirement: Some(Lb1Name::Full),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                alternating: Some(true),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                metagradient_clip: Some(1.0),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                confidence: Some(ConfidenceName::None),
+                quantile_factor: Some(2.0),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                gradients: Some(GradientsName::Exact),
+                reference_batch: Some(10),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgNaiveW),
+                w_direction: Some(WDirectionName::PlugIn),
+                ..RunSpec::default()
+            },
+        ];
+        for spec in bad {
+            assert!(spec.resolve().is_err(), "{spec:?}");
+        }
+    }
+
     #[test]
     fn algorithm_names_are_the_configuration_names() {
         let all = [
