@@ -88,10 +88,10 @@ fn exploring_w_step(ctx: &CheckContext<'_>) -> Evaluation {
                     HpForm::SignAware,
                 );
                 match thesis {
-                    Ok(StepOutcome::Feasible(t)) => {
-                        if t.hi > beta * (1.0 + 1e-9) + 1e-300 {
-                            count.shorter += 1;
-                        }
+                    Ok(StepOutcome::Feasible(t))
+                        if t.hi - beta > 1e-9 * beta.abs().max(t.hi.abs()) =>
+                    {
+                        count.shorter += 1;
                     }
                     Ok(StepOutcome::BelowNoise) => {
                         count.thesis_still += 1;
