@@ -7,7 +7,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 use sepg_runs::report::{self, Outputs};
-use sepg_runs::reproduce::{self, Experiment, LqgPreset, Mode, ReproduceOptions};
+use sepg_runs::reproduce::{
+    self, Experiment, LqgPreset, Mode, OptionFlags, ReproduceOptions, Setting,
+};
 use sepg_runs::sweep::SweepOptions;
 
 use crate::cli::CliError;
@@ -39,6 +41,13 @@ pub struct ReproduceArgs {
         allow_negative_numbers = true
     )]
     fig_sigma0: f64,
+    /// Named choice of the algorithm options: sepg's guaranteed defaults, the thesis-era
+    /// public code's choices, or the defaults without confidence widths.
+    #[arg(long, value_enum, default_value_t = Setting::Default)]
+    setting: Setting,
+    /// Options overriding the setting's.
+    #[command(flatten)]
+    flags: OptionFlags,
     /// Output folder [default: sepg-<experiment>].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -66,6 +75,8 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
         iterations: args.iterations,
         delta: args.delta,
         fig_sigma0: args.fig_sigma0,
+        setting: args.setting,
+        flags: args.flags,
     };
     let dir = args
         .out

@@ -19,6 +19,7 @@
 //! | [`budget`] | Definition 4.3, Theorem 4.1, eqs. (4.13)–(4.14) |
 //! | [`interval`] | outward-rounded interval arithmetic |
 //! | [`certified`] | certified safe steps: the bounds above evaluated in interval arithmetic |
+//! | [`exploring`] | the exploring w-update: Theorem 4.3 with the confidence on ∇_w J only |
 //!
 //! ```
 //! use sepg_bounds::{constants::TaskConstants, outcome::StepOutcome, v_update};
@@ -34,6 +35,7 @@ pub mod budget;
 pub mod certified;
 pub mod constants;
 pub mod error;
+pub mod exploring;
 pub mod greedy;
 pub mod high_probability;
 pub mod interval;

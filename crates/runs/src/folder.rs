@@ -15,6 +15,7 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use serde::{Deserialize, Serialize};
@@ -281,6 +282,26 @@ pub struct Summary {
     pub iterations_per_s: f64,
     /// Environment steps per second of wall time.
     pub env_steps_per_s: f64,
+    /// The SEPG options the run used (defaults for the comparison algorithms, which use only
+    /// the constant overrides).
+    #[serde(default)]
+    pub options: SepgOptions,
+    /// The task constants the bounds used, after the overrides.
+    #[serde(default)]
+    pub constants: UsedConstants,
+}
+
+/// The task constants γ, R, M_φ, |A| a run's bounds used (after the overrides).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct UsedConstants {
+    /// Discount factor γ.
+    pub gamma: f64,
+    /// Maximal absolute reward R.
+    pub r_max: f64,
+    /// Maximal absolute feature M_φ.
+    pub m_phi: f64,
+    /// Action-space volume |A|.
+    pub action_volume: f64,
 }
 
 /// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{Error, Result};
 use crate::figure::{self, Figure, Panel, Series, mean_band, mean_halfwidth};
 use crate::folder::{CONFIG_FILE, Log, SUMMARY_FILE, Summary, is_complete};
-use crate::reproduce::{Experiment, ReproduceOptions, TABLE_VARIANTS};
+use crate::reproduce::{Experiment, ReproduceOptions, Setting, TABLE_VARIANTS};
 use crate::spec::{EnvName, RunSpec};
 use crate::sweep::{SWEEP_FILE, Seeds, SweepFile};
 
@@ -97,7 +97,7 @@ fn fmt3(x: f64) -> String {
 }
 
 /// Table 5.1 as markdown and CSV.
-fn table(file: &SweepFile, runs: &[Loaded], delta: f64) -> (String, String) {
+fn table(file: &SweepFile, runs: &[Loaded], delta: f64, setting: Setting) -> (String, String) {
     let seeds = seed_count(&file.spec.seeds);
     let iterations = runs.first().map_or(0, |r| r.summary.iterations);
     let mut md = String::new();
@@ -105,8 +105,9 @@ fn table(file: &SweepFile, runs: &[Loaded], delta: f64) -> (String, String) {
     let _ = writeln!(
         md,
         "# Table 5.1: 95% upper confidence bound of |v − v*| after {iterations} iterations\n\n\
-         {seeds} seeds, N = 100, H = 20, γ = 0.99, v⁰ = −0.1, δ = {}. Each cell: ours (thesis). \
-         Bound: mean + t(0.975, K − 1)·s/√K across the K seeds.\n",
+         Setting `{}`: {seeds} seeds, N = 100, H = 20, γ = 0.99, v⁰ = −0.1, δ = {}. Each cell: \
+         ours (thesis). Bound: mean + t(0.975, K − 1)·s/√K across the K seeds.\n",
+        setting.name(),
         delta
     );
     for &preset in &file.spec.presets {
@@ -361,7 +362,7 @@ pub enum Outputs {
 pub fn write_outputs(opts: &ReproduceOptions, dir: &Path, file: &SweepFile) -> Result<Outputs> {
     let runs = load(dir, file)?;
     if opts.what == Experiment::Table51 {
-        let (markdown, csv) = table(file, &runs, opts.delta);
+        let (markdown, csv) = table(file, &runs, opts.delta, opts.setting);
         crate::folder::write_atomic(&dir.join("table-5.1.md"), markdown.as_bytes())?;
         crate::folder::write_atomic(&dir.join("table-5.1.csv"), csv.as_bytes())?;
         return Ok(Outputs::Table { markdown });

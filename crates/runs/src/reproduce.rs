@@ -12,7 +12,9 @@ use std::path::Path;
 use clap::ValueEnum;
 
 use crate::error::{Error, Result};
-use crate::spec::{AlgoName, EnvName, RunSpec};
+use crate::spec::{
+    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, WDirectionName, WStepName,
+};
 use crate::sweep::{self, Seeds, Shard, SweepFile, SweepOptions, SweepSpec, SweepStats};
 
 /// Variant names of Table 5.1, in the thesis's column order.
@@ -77,6 +79,153 @@ pub enum LqgPreset {
     Lqg1d,
 }
 
+/// A named choice of the algorithm options for a whole reproduction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+pub enum Setting {
+    /// sepg's defaults: the exploring w-update, Student-t widths at δ, the reference batch of
+    /// J(θ⁰), cross-fitted ∇̂_w L, ν-split LB-I, leave-one-out baselines.
+    #[default]
+    Default,
+    /// The choices of the thesis-era public code (potion, `algorithms/safe.py`, January
+    /// 2019): no confidence widths (δ = 1), the metagradient w-direction, LB-I's full
+    /// requirement per half-step, alternating v/w iterations for MI and LB-I, plug-in
+    /// baselines, no reference batch. No guarantee holds under it.
+    ThesisCode,
+    /// The thesis's algorithm as described, with estimates used as exact: the defaults
+    /// without confidence widths and without the reference batch. No guarantee holds under it.
+    NoConfidence,
+}
+
+impl Setting {
+    /// The setting's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Setting::Default => "default",
+            Setting::ThesisCode => "thesis-code",
+            Setting::NoConfidence => "no-confidence",
+        }
+    }
+
+    /// The options the setting fixes, as a partial run specification.
+    fn options(self) -> OptionFlags {
+        match self {
+            Setting::Default => OptionFlags::default(),
+            Setting::ThesisCode => OptionFlags {
+                confidence: Some(ConfidenceName::None),
+                w_direction: Some(WDirectionName::Metagradient),
+                lb1_requirement: Some(Lb1Name::Full),
+                alternating: Some(true),
+                baseline_fit: Some(FitName::PlugIn),
+                reference_batch: Some(0),
+                ..OptionFlags::default()
+            },
+            Setting::NoConfidence => OptionFlags {
+                confidence: Some(ConfidenceName::None),
+                reference_batch: Some(0),
+                ..OptionFlags::default()
+            },
+        }
+    }
+}
+
+/// The algorithm options of a reproduction (each overrides the setting's choice). The SEPG
+/// options reach the SEPG variants only (alternating: MI and LB-I; `lb1-requirement`: LB-I);
+/// the baseline fit and the constant overrides reach every variant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct OptionFlags {
+    /// Form of the SEPG w-update [default: exploring].
+    #[cfg_attr(feature = "clap", arg(long = "w-step", value_enum))]
+    pub w_step: Option<WStepName>,
+    /// Direction of the SEPG w-update [default: cross-fitted].
+    #[cfg_attr(feature = "clap", arg(long = "w-direction", value_enum))]
+    pub w_direction: Option<WDirectionName>,
+    /// Clipping threshold of the metagradient's last term [default: 100].
+    #[cfg_attr(feature = "clap", arg(long = "metagradient-clip"))]
+    pub metagradient_clip: Option<f64>,
+    /// Confidence widths of sampled SEPG [default: student-t].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub confidence: Option<ConfidenceName>,
+    /// Multiplier of the Student-t quantile [default: 1].
+    #[cfg_attr(feature = "clap", arg(long = "quantile-factor"))]
+    pub quantile_factor: Option<f64>,
+    /// LB-I's requirement per half-step [default: split].
+    #[cfg_attr(feature = "clap", arg(long = "lb1-requirement", value_enum))]
+    pub lb1_requirement: Option<Lb1Name>,
+    /// Alternate v- and w-iterations (MI, LB-I) [default: false].
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub alternating: Option<bool>,
+    /// Trajectories of the reference batch of J(θ⁰), 0 for none [default: 1000].
+    #[cfg_attr(feature = "clap", arg(long = "reference-batch"))]
+    pub reference_batch: Option<usize>,
+    /// How the estimators' baselines are fitted [default: leave-one-out].
+    #[cfg_attr(feature = "clap", arg(long = "baseline-fit", value_enum))]
+    pub baseline_fit: Option<FitName>,
+    /// Discount factor γ [default: 0.99].
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub gamma: Option<f64>,
+    /// R used by the bounds [default: the environment's].
+    #[cfg_attr(feature = "clap", arg(long = "r-max"))]
+    pub r_max: Option<f64>,
+    /// M_φ used by the bounds [default: the environment's].
+    #[cfg_attr(feature = "clap", arg(long = "m-phi"))]
+    pub m_phi: Option<f64>,
+    /// |A| used by the bounds [default: the environment's].
+    #[cfg_attr(feature = "clap", arg(long = "action-volume"))]
+    pub action_volume: Option<f64>,
+}
+
+impl OptionFlags {
+    /// These flags, each falling back to `base`'s.
+    fn over(self, base: OptionFlags) -> OptionFlags {
+        macro_rules! pick {
+            ($($f:ident),*) => { OptionFlags { $($f: self.$f.or(base.$f),)* } };
+        }
+        pick!(
+            w_step,
+            w_direction,
+            metagradient_clip,
+            confidence,
+            quantile_factor,
+            lb1_requirement,
+            alternating,
+            reference_batch,
+            baseline_fit,
+            gamma,
+            r_max,
+            m_phi,
+            action_volume
+        )
+    }
+
+    /// The options for a variant running `algo`.
+    fn for_variant(self, algo: AlgoName) -> RunSpec {
+        let sepg = !matches!(
+            algo,
+            AlgoName::GpomdpConst | AlgoName::GpomdpAdam | AlgoName::Adastep
+        );
+        RunSpec {
+            w_step: self.w_step.filter(|_| sepg),
+            w_direction: self.w_direction.filter(|_| sepg),
+            metagradient_clip: self.metagradient_clip.filter(|_| sepg),
+            confidence: self.confidence.filter(|_| sepg),
+            quantile_factor: self.quantile_factor.filter(|_| sepg),
+            lb1_requirement: self.lb1_requirement.filter(|_| algo == AlgoName::SepgLb1),
+            alternating: self
+                .alternating
+                .filter(|_| matches!(algo, AlgoName::SepgMi | AlgoName::SepgLb1)),
+            reference_batch: self.reference_batch.filter(|_| sepg),
+            baseline_fit: self.baseline_fit,
+            gamma: self.gamma,
+            r_max: self.r_max,
+            m_phi: self.m_phi,
+            action_volume: self.action_volume,
+            ..RunSpec::default()
+        }
+    }
+}
+
 /// The options of a reproduction: which experiment, and the protocol settings a user may
 /// change.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,6 +242,10 @@ pub struct ReproduceOptions {
     pub delta: f64,
     /// σ⁰ of the LQG figures (Figures 5.1 to 5.3).
     pub fig_sigma0: f64,
+    /// The named choice of algorithm options.
+    pub setting: Setting,
+    /// Options overriding the setting's.
+    pub flags: OptionFlags,
 }
 
 impl ReproduceOptions {
@@ -106,6 +259,8 @@ impl ReproduceOptions {
             iterations: None,
             delta: 0.2,
             fig_sigma0: 1.0,
+            setting: Setting::Default,
+            flags: OptionFlags::default(),
         }
     }
 }
@@ -238,6 +393,14 @@ pub fn sweep_spec(opts: &ReproduceOptions) -> Result<SweepSpec> {
         ..RunSpec::default()
     };
     let (variant, sigma0) = variants(opts);
+    let flags = opts.flags.over(opts.setting.options());
+    let variant = variant
+        .into_iter()
+        .map(|v| match v.algo {
+            Some(algo) => flags.for_variant(algo).overlay(&v),
+            None => v,
+        })
+        .collect();
     Ok(SweepSpec {
         presets,
         seeds: Seeds::Count(opts.seeds),
@@ -276,4 +439,44 @@ pub fn run(
         Mode::Start { force } => sweep::start(dir, &file, &resolved, force, sweep_opts)?,
     };
     Ok((file, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thesis-code setting reaches the SEPG variants (alternating and LB-I's full
+    /// requirement only where they apply), the baseline fit reaches every variant, and a flag
+    /// overrides the setting.
+    #[test]
+    fn settings_reach_the_variants_they_apply_to() {
+        let opts = ReproduceOptions {
+            setting: Setting::ThesisCode,
+            flags: OptionFlags {
+                confidence: Some(ConfidenceName::StudentT),
+                ..OptionFlags::default()
+            },
+            ..ReproduceOptions::new(Experiment::Table51)
+        };
+        let spec = sweep_spec(&opts).expect("valid");
+        let by_name = |n: &str| {
+            spec.variant
+                .iter()
+                .find(|v| v.name.as_deref() == Some(n))
+                .expect("variant")
+        };
+        let (lb1, zv, adam) = (by_name("lb1"), by_name("zv"), by_name("adam-1e-4"));
+        assert_eq!(lb1.alternating, Some(true));
+        assert_eq!(lb1.lb1_requirement, Some(Lb1Name::Full));
+        assert_eq!(zv.alternating, None);
+        assert_eq!(zv.w_direction, Some(WDirectionName::Metagradient));
+        assert_eq!(zv.confidence, Some(ConfidenceName::StudentT));
+        assert_eq!(adam.w_direction, None);
+        assert_eq!(adam.baseline_fit, Some(FitName::PlugIn));
+        let (_, resolved) = crate::sweep::expand(&spec, crate::sweep::Shard { index: 0, count: 1 })
+            .expect("every run resolves");
+        assert_eq!(resolved.len(), 880);
+        let default = sweep_spec(&ReproduceOptions::new(Experiment::Table51)).expect("valid");
+        assert!(default.variant.iter().all(|v| v.w_direction.is_none()));
+    }
 }

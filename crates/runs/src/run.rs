@@ -24,8 +24,8 @@ use sepg_algo::solver::PolicySolver;
 use crate::error::{Error, Result};
 use crate::folder::{
     CHECKPOINT_FILE, CONFIG_FILE, Checkpoint, FinalParams, LOG_FILE, PARTIAL_LOG_FILE,
-    SUMMARY_FILE, Summary, Tally, io_fail, is_complete, load_resolved, log_header, log_row,
-    read_summary, to_json_line, write_atomic,
+    SUMMARY_FILE, Summary, Tally, UsedConstants, io_fail, is_complete, load_resolved, log_header,
+    log_row, read_summary, to_json_line, write_atomic,
 };
 use crate::spec::{Resolved, VERSION};
 
@@ -273,6 +273,16 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
         wall_time_s: wall,
         iterations_per_s: rate(s.iteration as f64),
         env_steps_per_s: rate(s.steps as f64),
+        options: resolved.checked.config().options,
+        constants: {
+            let k = resolved.checked.constants();
+            UsedConstants {
+                gamma: k.gamma(),
+                r_max: k.r_max(),
+                m_phi: k.m_phi(),
+                action_volume: k.action_volume(),
+            }
+        },
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     Ok(summary)

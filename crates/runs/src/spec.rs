@@ -10,6 +10,9 @@ use std::path::Path;
 #[cfg(feature = "clap")]
 use clap::{Args, ValueEnum};
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
+use sepg_algo::core::options::{
+    Confidence, ConstantOverrides, Lb1Requirement, SepgOptions, WDirection, WStep,
+};
 use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
 use sepg_mdp::mountain_car::MountainCar;
@@ -91,6 +94,20 @@ impl AlgoName {
 
     /// Whether the algorithm splits its requirement with ν (LB-I and SIM-ν, Table 4.1, also
     /// as the requirement of `sepg-naive-w`).
+    /// Whether the algorithm is a SEPG variant (the SEPG options apply).
+    fn is_sepg(self) -> bool {
+        matches!(
+            self,
+            AlgoName::SepgMi
+                | AlgoName::SepgLb1
+                | AlgoName::SepgLb2
+                | AlgoName::SepgLv
+                | AlgoName::SepgZv
+                | AlgoName::SepgSim
+                | AlgoName::SepgNaiveW
+        )
+    }
+
     fn uses_nu(self, requirement: Option<RequirementName>) -> bool {
         matches!(self, AlgoName::SepgLb1 | AlgoName::SepgSim)
             || (self == AlgoName::SepgNaiveW
@@ -181,6 +198,54 @@ pub enum FitName {
     LeaveOneOut,
     /// One baseline from the whole batch.
     PlugIn,
+}
+
+/// The w-update form accepted by `--w-step`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum WStepName {
+    /// As far along the direction as Theorem 4.3 with the confidence on ∇_w J allows.
+    Exploring,
+    /// Theorem 4.9 (corrected norms; no update when the direction is within its width).
+    #[cfg_attr(feature = "clap", value(name = "theorem-4.9"))]
+    #[serde(rename = "theorem-4.9")]
+    Theorem49,
+}
+
+/// The w-direction accepted by `--w-direction`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum WDirectionName {
+    /// ∇̂_w L cross-fitted on two halves of the batch (unbiased).
+    CrossFitted,
+    /// ∇̂_w L from full-batch plug-in products (biased upwards).
+    PlugIn,
+    /// The thesis-era code's w-derivative of J + α‖∇_v J‖² (scalar actions).
+    Metagradient,
+}
+
+/// The confidence widths accepted by `--confidence`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ConfidenceName {
+    /// Student-t widths times `quantile-factor` (Sec 4.5).
+    StudentT,
+    /// No widths: estimates used as exact (the thesis-era code's δ = 1).
+    None,
+}
+
+/// LB-I's requirement per half-step, accepted by `--lb1-requirement`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Lb1Name {
+    /// (1 − ν)C for the v-update, νC for the w-update (eqs. 4.13, 4.14).
+    Split,
+    /// The whole requirement, measured at the start of each half-step.
+    Full,
 }
 
 /// One value broadcast to every component, or one value per component.
@@ -343,6 +408,63 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(skip))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sepg_version: Option<String>,
+    /// Form of the SEPG w-update [default: exploring].
+    #[cfg_attr(feature = "clap", arg(long = "w-step", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub w_step: Option<WStepName>,
+    /// Direction of the SEPG w-update [default: cross-fitted].
+    #[cfg_attr(feature = "clap", arg(long = "w-direction", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub w_direction: Option<WDirectionName>,
+    /// Clipping threshold of the metagradient's last term [default: 100].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "metagradient-clip", allow_hyphen_values = true)
+    )]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub metagradient_clip: Option<f64>,
+    /// Confidence widths of sampled SEPG [default: student-t].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub confidence: Option<ConfidenceName>,
+    /// Multiplier of the Student-t quantile of the widths [default: 1].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "quantile-factor", allow_hyphen_values = true)
+    )]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantile_factor: Option<f64>,
+    /// LB-I's requirement per half-step [default: split].
+    #[cfg_attr(feature = "clap", arg(long = "lb1-requirement", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lb1_requirement: Option<Lb1Name>,
+    /// Alternate v- and w-iterations with all N trajectories each (MI, LB-I) [default: false].
+    #[cfg_attr(feature = "clap", arg(long))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alternating: Option<bool>,
+    /// Trajectories of the reference batch of J(θ⁰), 0 for none [default: 1000].
+    #[cfg_attr(feature = "clap", arg(long = "reference-batch"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_batch: Option<usize>,
+    /// Discount factor γ [default: the environment's, 0.99].
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gamma: Option<f64>,
+    /// Maximal absolute reward R used by the bounds [default: the environment's].
+    #[cfg_attr(feature = "clap", arg(long = "r-max", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub r_max: Option<f64>,
+    /// Maximal absolute feature M_φ used by the bounds [default: the environment's].
+    #[cfg_attr(feature = "clap", arg(long = "m-phi", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub m_phi: Option<f64>,
+    /// Action-space volume |A| used by the bounds [default: the environment's].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "action-volume", allow_hyphen_values = true)
+    )]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub action_volume: Option<f64>,
 }
 
 macro_rules! overlay_fields {
@@ -357,7 +479,9 @@ impl RunSpec {
         let base = self;
         overlay_fields!(base, top; name, env, features, algo, requirement, gradients, delta, nu,
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
-            estimator, baseline, baseline_fit, log_every, sepg_version)
+            estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
+            metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
+            reference_batch, gamma, r_max, m_phi, action_volume)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -394,6 +518,7 @@ impl RunSpec {
         self.reject_inapplicable(algo, gradients)?;
         let method = self.method(algo)?;
         let sampling = self.sampling(gradients);
+        let options = self.options(algo, gradients);
         let dim_w = env.action_dim();
         let dim_v = dim_w * env.feature_dim();
         let start = self.start(env_name, dim_v, dim_w)?;
@@ -410,6 +535,7 @@ impl RunSpec {
             iterations: schedule.iterations,
             seed: schedule.seed,
             initial_budget: start.budget0,
+            options: options.unwrap_or_default(),
         };
         let checked = config
             .check()
@@ -425,7 +551,7 @@ impl RunSpec {
                     .clone()
                     .unwrap_or_else(|| VERSION.to_owned()),
             ),
-            ..RunSpec::resolved_values(&method, &sampling, start, &schedule)
+            ..RunSpec::resolved_values(&method, &sampling, start, &schedule, options.as_ref())
         };
         Ok(Resolved {
             spec,
@@ -457,7 +583,54 @@ impl RunSpec {
             "lr/lr-w",
             &for_algo,
         )?;
+        let sepg = algo.is_sepg();
+        reject(
+            !sepg
+                && (self.w_step.is_some()
+                    || self.w_direction.is_some()
+                    || self.metagradient_clip.is_some()
+                    || self.lb1_requirement.is_some()
+                    || self.alternating.is_some()
+                    || self.reference_batch.is_some()
+                    || self.confidence.is_some()
+                    || self.quantile_factor.is_some()),
+            "w-step/w-direction/metagradient-clip/lb1-requirement/alternating/\
+             reference-batch/confidence/quantile-factor",
+            &for_algo,
+        )?;
+        let naive = algo == AlgoName::SepgNaiveW;
+        reject(
+            naive && (self.w_step.is_some() || self.w_direction.is_some()),
+            "w-step/w-direction",
+            &for_algo,
+        )?;
+        reject(
+            self.metagradient_clip.is_some()
+                && self.w_direction != Some(WDirectionName::Metagradient),
+            "metagradient-clip",
+            "without w-direction metagradient",
+        )?;
+        reject(
+            self.quantile_factor.is_some() && self.confidence == Some(ConfidenceName::None),
+            "quantile-factor",
+            "with confidence none",
+        )?;
+        let lb1 =
+            algo == AlgoName::SepgLb1 || (naive && self.requirement == Some(RequirementName::Lb1));
+        reject(
+            !lb1 && self.lb1_requirement.is_some(),
+            "lb1-requirement",
+            &for_algo,
+        )?;
         let exact = gradients == GradientsName::Exact;
+        reject(
+            exact
+                && (self.confidence.is_some()
+                    || self.quantile_factor.is_some()
+                    || self.reference_batch.is_some()),
+            "confidence/quantile-factor/reference-batch",
+            "to exact gradients",
+        )?;
         reject(exact && self.delta.is_some(), "delta", "to exact gradients")?;
         reject(
             exact
@@ -514,6 +687,56 @@ impl RunSpec {
             AlgoName::Adastep => Algorithm::AdaStep,
         };
         Ok(method)
+    }
+
+    /// The SEPG options with their defaults ([`SepgOptions`]); for the comparison algorithms
+    /// only the constant overrides (the options were checked to apply).
+    fn options(&self, algo: AlgoName, gradients: GradientsName) -> Option<SepgOptions> {
+        let overrides = ConstantOverrides {
+            gamma: self.gamma,
+            r_max: self.r_max,
+            m_phi: self.m_phi,
+            action_volume: self.action_volume,
+        };
+        let defaults = SepgOptions::default();
+        if !algo.is_sepg() {
+            return Some(SepgOptions {
+                overrides,
+                ..defaults
+            });
+        }
+        let sampled = gradients == GradientsName::Sampled;
+        Some(SepgOptions {
+            w_step: match self.w_step {
+                Some(WStepName::Theorem49) => WStep::Theorem49,
+                Some(WStepName::Exploring) => WStep::Exploring,
+                None => defaults.w_step,
+            },
+            w_direction: match self.w_direction {
+                Some(WDirectionName::PlugIn) => WDirection::PlugIn,
+                Some(WDirectionName::Metagradient) => WDirection::Metagradient {
+                    clip: self.metagradient_clip.unwrap_or(100.0),
+                },
+                Some(WDirectionName::CrossFitted) | None => defaults.w_direction,
+            },
+            confidence: match self.confidence {
+                Some(ConfidenceName::None) => Confidence::None,
+                Some(ConfidenceName::StudentT) | None => Confidence::StudentT {
+                    factor: self.quantile_factor.unwrap_or(1.0),
+                },
+            },
+            lb1_requirement: match self.lb1_requirement {
+                Some(Lb1Name::Full) => Lb1Requirement::Full,
+                Some(Lb1Name::Split) | None => defaults.lb1_requirement,
+            },
+            alternating: self.alternating.unwrap_or(false),
+            reference_batch: if sampled {
+                self.reference_batch.unwrap_or(defaults.reference_batch)
+            } else {
+                0
+            },
+            overrides,
+        })
     }
 
     /// The confidence and estimator of the sampled mode (`None` for exact gradients).
@@ -584,6 +807,7 @@ impl RunSpec {
         sampling: &Sampling,
         start: Start,
         schedule: &Schedule,
+        options: Option<&SepgOptions>,
     ) -> RunSpec {
         let one_or_many = |v: Vec<f64>| {
             if v.len() == 1 {
@@ -612,7 +836,61 @@ impl RunSpec {
             baseline: estimator.map(|e| e.1),
             baseline_fit: estimator.map(|e| e.2),
             log_every: Some(schedule.log_every),
+            ..RunSpec::option_values(method, sampling, options)
+        }
+    }
+
+    /// The resolved SEPG options and constant overrides: every SEPG option of a SEPG run (the
+    /// sampled-only ones in the sampled mode), the overrides that were given.
+    fn option_values(
+        method: &Method,
+        sampling: &Sampling,
+        options: Option<&SepgOptions>,
+    ) -> RunSpec {
+        let Some(o) = options else {
+            return RunSpec::default();
+        };
+        let overrides = RunSpec {
+            gamma: o.overrides.gamma,
+            r_max: o.overrides.r_max,
+            m_phi: o.overrides.m_phi,
+            action_volume: o.overrides.action_volume,
             ..RunSpec::default()
+        };
+        let (sepg, naive, lb1) = match method.algorithm {
+            Algorithm::Sepg(r) => (true, false, matches!(r, Requirement::LbI { .. })),
+            Algorithm::SepgNaiveW(r) => (true, true, matches!(r, Requirement::LbI { .. })),
+            _ => (false, false, false),
+        };
+        if !sepg {
+            return overrides;
+        }
+        let sampled = sampling.0.is_some();
+        let (confidence, quantile_factor) = match o.confidence {
+            Confidence::None => (ConfidenceName::None, None),
+            Confidence::StudentT { factor } => (ConfidenceName::StudentT, Some(factor)),
+        };
+        let (w_direction, clip) = match o.w_direction {
+            WDirection::CrossFitted => (WDirectionName::CrossFitted, None),
+            WDirection::PlugIn => (WDirectionName::PlugIn, None),
+            WDirection::Metagradient { clip } => (WDirectionName::Metagradient, Some(clip)),
+        };
+        RunSpec {
+            w_step: (!naive).then_some(match o.w_step {
+                WStep::Exploring => WStepName::Exploring,
+                WStep::Theorem49 => WStepName::Theorem49,
+            }),
+            w_direction: (!naive).then_some(w_direction),
+            metagradient_clip: clip,
+            confidence: sampled.then_some(confidence),
+            quantile_factor: quantile_factor.filter(|_| sampled),
+            lb1_requirement: lb1.then_some(match o.lb1_requirement {
+                Lb1Requirement::Split => Lb1Name::Split,
+                Lb1Requirement::Full => Lb1Name::Full,
+            }),
+            alternating: Some(o.alternating),
+            reference_batch: sampled.then_some(o.reference_batch),
+            ..overrides
         }
     }
 }
@@ -828,6 +1106,103 @@ mod tests {
             ..RunSpec::default()
         };
         assert!(spec.resolve().is_err());
+    }
+
+    /// Every SEPG option reaches the algorithm's configuration, is written back into the
+    /// resolved specification, and survives a round trip through config.toml.
+    #[test]
+    fn sepg_options_resolve_and_round_trip() {
+        let spec = RunSpec {
+            env: Some(EnvName::Lqg1d),
+            algo: Some(AlgoName::SepgLb1),
+            w_step: Some(WStepName::Theorem49),
+            w_direction: Some(WDirectionName::Metagradient),
+            metagradient_clip: Some(50.0),
+            confidence: Some(ConfidenceName::StudentT),
+            quantile_factor: Some(2.0),
+            lb1_requirement: Some(Lb1Name::Full),
+            alternating: Some(true),
+            reference_batch: Some(0),
+            gamma: Some(0.9),
+            r_max: Some(30.0),
+            ..RunSpec::default()
+        };
+        let once = spec.resolve().expect("valid");
+        let o = once.checked.config().options;
+        assert_eq!(o.w_step, WStep::Theorem49);
+        assert_eq!(o.w_direction, WDirection::Metagradient { clip: 50.0 });
+        assert_eq!(o.confidence, Confidence::StudentT { factor: 2.0 });
+        assert_eq!(o.lb1_requirement, Lb1Requirement::Full);
+        assert!(o.alternating);
+        assert_eq!(o.reference_batch, 0);
+        assert_eq!(once.checked.constants().gamma(), 0.9);
+        assert_eq!(once.checked.constants().r_max(), 30.0);
+        assert_eq!(once.spec.m_phi, None);
+        let text = once.toml().expect("toml");
+        assert!(
+            text.contains("w-step = \"theorem-4.9\"") && text.contains("quantile-factor = 2.0")
+        );
+        let again: RunSpec = toml::from_str(&text).expect("parse");
+        let twice = again.resolve().expect("valid");
+        assert_eq!(once.spec, twice.spec);
+        assert_eq!(once.checked, twice.checked);
+        // The defaults are written out too.
+        let plain = RunSpec {
+            algo: Some(AlgoName::SepgZv),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid");
+        assert_eq!(plain.spec.w_step, Some(WStepName::Exploring));
+        assert_eq!(plain.spec.confidence, Some(ConfidenceName::StudentT));
+        assert_eq!(plain.spec.reference_batch, Some(1000));
+        assert_eq!(plain.spec.lb1_requirement, None);
+    }
+
+    #[test]
+    fn sepg_options_that_do_not_apply_are_rejected() {
+        let bad = [
+            RunSpec {
+                algo: Some(AlgoName::GpomdpAdam),
+                lr: Some(1e-3),
+                w_step: Some(WStepName::Exploring),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                lb1_requirement: Some(Lb1Name::Full),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                alternating: Some(true),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                metagradient_clip: Some(1.0),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgZv),
+                confidence: Some(ConfidenceName::None),
+                quantile_factor: Some(2.0),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                gradients: Some(GradientsName::Exact),
+                reference_batch: Some(10),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                algo: Some(AlgoName::SepgNaiveW),
+                w_direction: Some(WDirectionName::PlugIn),
+                ..RunSpec::default()
+            },
+        ];
+        for spec in bad {
+            assert!(spec.resolve().is_err(), "{spec:?}");
+        }
     }
 
     #[test]

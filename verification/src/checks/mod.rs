@@ -5,6 +5,7 @@ mod appendix_a;
 mod certified;
 mod chapter3;
 mod chapter4;
+mod exploring;
 mod lqg_exact;
 pub(crate) mod sampled;
 
@@ -29,5 +30,6 @@ pub fn registry() -> Vec<Check> {
     checks.extend(sampled::checks());
     checks.extend(algorithm::checks());
     checks.extend(certified::checks());
+    checks.extend(exploring::checks());
     checks
 }

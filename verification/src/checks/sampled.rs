@@ -38,18 +38,24 @@ use crate::stats::{clopper_pearson_lower, clopper_pearson_upper};
 const FAMILY_ALPHA: f64 = 1e-3;
 
 /// A policy on a preset, with its exact values, rollouts and estimators.
-struct Setting {
-    task: Task,
+pub(crate) struct Setting {
+    pub(crate) task: Task,
     env: LqgEnv,
     policy: GaussianPolicy,
-    v: f64,
-    w: f64,
-    sigma: f64,
-    exact: ExactEval,
+    pub(crate) v: f64,
+    pub(crate) w: f64,
+    pub(crate) sigma: f64,
+    pub(crate) exact: ExactEval,
 }
 
 impl Setting {
-    fn new(preset: Preset, gamma: f64, sigma: f64, v: f64, clipped: bool) -> Option<Self> {
+    pub(crate) fn new(
+        preset: Preset,
+        gamma: f64,
+        sigma: f64,
+        v: f64,
+        clipped: bool,
+    ) -> Option<Self> {
         let task = if clipped {
             Task::new(preset, gamma)?
         } else {
@@ -69,7 +75,7 @@ impl Setting {
         })
     }
 
-    fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
+    pub(crate) fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
         rollout(
             &self.env,
             &self.policy,
@@ -80,7 +86,7 @@ impl Setting {
         .ok()
     }
 
-    fn k(&self) -> &TaskConstants {
+    pub(crate) fn k(&self) -> &TaskConstants {
         &self.task.k
     }
 }
@@ -228,9 +234,9 @@ fn z_outcome(tests: &[ZTest]) -> Evaluation {
 }
 
 /// Trajectories per batch of the sampled checks (the experiments' N).
-const N: usize = 100;
+pub(crate) const N: usize = 100;
 
-fn estimate(
+pub(crate) fn estimate(
     est: &mut Estimator,
     batch: &Batch,
     param: Param,
@@ -425,7 +431,7 @@ fn hp_counts(
     counts
 }
 
-fn hp_settings() -> [(Preset, f64, f64); 2] {
+pub(crate) fn hp_settings() -> [(Preset, f64, f64); 2] {
     [(Preset::Lqg, 1.0, -0.1), (Preset::Lqg1d, 0.5, -0.3)]
 }
 
@@ -801,7 +807,13 @@ fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
     eval
 }
 
-fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &str) -> CheckMeta {
+pub(crate) fn meta(
+    id: &str,
+    statement: &str,
+    location: &str,
+    claim: &str,
+    ground_truth: &str,
+) -> CheckMeta {
     CheckMeta {
         id: id.into(),
         statement: statement.into(),
@@ -822,7 +834,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
     }
 }
 
-const DP_TRUTH: &str = "exact J_H and gradients of the clipped preset (DP oracle), \
+pub(crate) const DP_TRUTH: &str = "exact J_H and gradients of the clipped preset (DP oracle), \
 realised improvement J(θ′) − J(θ) evaluated exactly for the step computed from each batch";
 
 const Z_FAR: &str = "1e-3 family-wise: two-sided z-test of the mean of independent batch \

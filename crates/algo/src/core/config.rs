@@ -6,6 +6,7 @@ use sepg_mdp::env::{AnyEnv, Environment};
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
+use crate::core::options::{SepgOptions, WDirection};
 use crate::core::state::State;
 
 /// Safety requirement of SEPG (Table 4.1, SPEC §5).
@@ -239,6 +240,10 @@ pub struct SepgConfig {
     pub seed: u64,
     /// Initial budget B⁰ ≥ 0 (Algorithm 4.3; SPEC §5 default 0).
     pub initial_budget: f64,
+    /// Options of SEPG: the form and direction of the w-update, confidence widths, LB-I's
+    /// requirement, alternating iterations, the reference batch of J(θ⁰), constant overrides
+    /// (ignored by the comparison algorithms except the overrides).
+    pub options: SepgOptions,
 }
 
 impl SepgConfig {
@@ -260,6 +265,7 @@ impl SepgConfig {
             iterations: 10_000,
             seed: 0,
             initial_budget: 0.0,
+            options: SepgOptions::default(),
         }
     }
 
@@ -270,9 +276,53 @@ impl SepgConfig {
     /// lengths, δ ∉ (0, 1), zero iterations, H = 0, B⁰ < 0 or non-finite, N too small to give
     /// every block at least 2 trajectories (4 for a block that estimates ∇_w L, whose
     /// estimator is cross-fitted on two halves), bad hyper-parameters, exact mode without an
-    /// exact oracle, or environment constants the bounds reject.
-    pub fn check(self) -> Result<CheckedConfig, ConfigError> {
+    /// exact oracle, options that do not apply (alternating iterations outside MI and LB-I,
+    /// the metagradient direction with several action dimensions), or environment constants
+    /// (after the overrides) the bounds reject.
+    pub fn check(mut self) -> Result<CheckedConfig, ConfigError> {
         self.algorithm.validate()?;
+        self.options.validate()?;
+        let requirement = match self.algorithm {
+            Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => Some(r),
+            _ => None,
+        };
+        if self.options.alternating
+            && !matches!(requirement, Some(Requirement::Mi | Requirement::LbI { .. }))
+        {
+            return Err(ConfigError::UnsupportedOption {
+                option: "alternating",
+                reason: "alternating v/w iterations exist for SEPG-MI and SEPG-LB-I only",
+            });
+        }
+        if matches!(self.options.w_direction, WDirection::Metagradient { .. })
+            && self.env.action_dim() != 1
+        {
+            return Err(ConfigError::UnsupportedOption {
+                option: "w_direction",
+                reason: "the metagradient direction needs a scalar action",
+            });
+        }
+        if let Some(gamma) = self.options.overrides.gamma {
+            self.env = match self.env {
+                AnyEnv::Lqg(e) => {
+                    let model = e
+                        .model()
+                        .clone()
+                        .with_gamma(gamma)
+                        .map_err(|e| ConfigError::Environment(e.to_string()))?;
+                    let horizon = e.constants().horizon;
+                    AnyEnv::Lqg(Box::new(
+                        sepg_mdp::env::LqgEnv::new(model)
+                            .and_then(|env| env.with_horizon(horizon))
+                            .map_err(|e| ConfigError::Environment(e.to_string()))?,
+                    ))
+                }
+                AnyEnv::MountainCar(m) => AnyEnv::MountainCar(
+                    m.with_gamma(gamma)
+                        .map_err(|e| ConfigError::Environment(e.to_string()))?,
+                ),
+            };
+        }
         if self.iterations == 0 {
             return Err(ConfigError::ZeroIterations);
         }
@@ -325,8 +375,14 @@ impl SepgConfig {
             }
         }
         let k = self.env.constants();
-        let constants = TaskConstants::new(k.gamma, k.r_max, k.m_phi, k.action_volume)
-            .map_err(|e| ConfigError::Environment(e.to_string()))?;
+        let o = self.options.overrides;
+        let constants = TaskConstants::new(
+            k.gamma,
+            o.r_max.unwrap_or(k.r_max),
+            o.m_phi.unwrap_or(k.m_phi),
+            o.action_volume.unwrap_or(k.action_volume),
+        )
+        .map_err(|e| ConfigError::Environment(e.to_string()))?;
         Ok(CheckedConfig {
             inner: self,
             constants,

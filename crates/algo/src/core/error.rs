@@ -84,6 +84,15 @@ pub enum ConfigError {
     /// The environment could not be built from its specification.
     #[error("invalid environment: {0}")]
     Environment(String),
+    /// An option of [`SepgOptions`](crate::core::options::SepgOptions) does not apply to the
+    /// chosen algorithm or environment.
+    #[error("option {option} is not supported here: {reason}")]
+    UnsupportedOption {
+        /// The option.
+        option: &'static str,
+        /// Why, in words.
+        reason: &'static str,
+    },
 }
 
 /// Why an iteration could not be carried out.

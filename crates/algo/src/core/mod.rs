@@ -3,6 +3,7 @@ pub mod adam;
 pub mod config;
 pub mod error;
 pub mod executor;
+pub mod options;
 pub mod record;
 pub mod seed;
 pub mod state;

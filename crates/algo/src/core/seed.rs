@@ -15,6 +15,11 @@ pub enum Block {
     Target,
     /// The w-block: estimates J(vᵗ⁺¹, wᵗ), ∇_w J and ∇_w L (lines 14–18).
     W,
+    /// The reference batch of J(θ⁰), run once before the first iteration.
+    Reference,
+    /// The reference batch of the first target policy's J, run once before the first
+    /// iteration.
+    ReferenceTarget,
 }
 
 impl Block {
@@ -22,7 +27,8 @@ impl Block {
     ///
     /// # Formula
     /// ```text
-    /// key = (seed, iteration, tag),   tag = 0 (v), 1 (target), 2 (w)
+    /// key = (seed, iteration, tag),   tag = 0 (v), 1 (target), 2 (w),
+    ///                                       3 (reference), 4 (reference target)
     /// ```
     ///
     /// # Examples
@@ -36,6 +42,8 @@ impl Block {
             Block::V => 0,
             Block::Target => 1,
             Block::W => 2,
+            Block::Reference => 3,
+            Block::ReferenceTarget => 4,
         };
         SeedKey::new(seed, iteration, tag)
     }

@@ -32,6 +32,9 @@ pub struct State {
     pub trajectories: u64,
     /// Environment steps used so far.
     pub steps: u64,
+    /// Step size α of the latest v-update (the metagradient w-direction uses it).
+    #[serde(default)]
+    pub last_alpha: Option<f64>,
 }
 
 impl State {
@@ -57,6 +60,7 @@ impl State {
             adam: None,
             trajectories: 0,
             steps: 0,
+            last_alpha: None,
         }
     }
 

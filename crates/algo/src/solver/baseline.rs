@@ -38,6 +38,7 @@ pub(crate) fn iterate(
             grad_v: true,
             grad_wj: !fixed_sigma,
             grad_wl: false,
+            j_width: false,
         },
     })?;
     let missing = || RunError::Estimator("the block returned no gradient".into());

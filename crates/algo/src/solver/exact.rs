@@ -3,7 +3,7 @@ use sepg_bounds::constants::TaskConstants;
 use sepg_mdp::oracle::{ExactOracle, Exploration, Horizon, Needs};
 
 use crate::core::error::RunError;
-use crate::solver::source::{Estimate, Grad, GradientSource, Query};
+use crate::solver::source::{Estimate, Grad, GradientSource, Query, SurrogateParts};
 use crate::solver::steps;
 
 /// A [`GradientSource`] backed by an exact oracle: no trajectories, ε = 0.
@@ -54,11 +54,17 @@ impl GradientSource for ExactSource {
         } else {
             None
         };
+        let parts = q.need.grad_wl.then(|| SurrogateParts {
+            grad_v: e.grad_v.clone(),
+            mixed_sigma: e.mixed_sigma_v(),
+        });
         Ok(Estimate {
             j: e.j,
             grad_v: q.need.grad_v.then(|| Grad::exact(e.grad_v.clone())),
             grad_wj: q.need.grad_wj.then(|| Grad::exact(e.grad_w.clone())),
             grad_wl,
+            parts,
+            j_width: 0.0,
             trajectories: 0,
             steps: 0,
         })

@@ -16,7 +16,9 @@
 //! exec.run(3)?;
 //! drop(exec);
 //! assert_eq!(log.records.len(), 3);
-//! assert_eq!(log.records[2].trajectories, 90);
+//! // 3 iterations of N = 30, after the reference batches of J(θ⁰) and of the first target
+//! let reference = checked.config().options.reference_batch as u64;
+//! assert_eq!(log.records[2].trajectories, 90 + 2 * reference);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub(crate) mod baseline;
@@ -34,6 +36,7 @@ use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 use crate::core::config::{Algorithm, CheckedConfig, GradientMode, check_sampled};
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
+use crate::core::options::SepgOptions;
 use crate::core::record::Record;
 use crate::core::state::State;
 use crate::solver::exact::ExactSource;
@@ -46,6 +49,7 @@ pub struct PolicySolver {
     n: usize,
     dims: (usize, usize),
     constants: TaskConstants,
+    options: SepgOptions,
     source: Box<dyn GradientSource>,
     certified: bool,
 }
@@ -77,6 +81,7 @@ impl PolicySolver {
                 cfg.horizon,
                 cfg.seed,
                 delta,
+                cfg.options.confidence.factor(),
                 cfg.estimator,
                 constants,
             )),
@@ -102,11 +107,17 @@ impl PolicySolver {
                 ))
             }
         };
+        let mut options = cfg.options;
+        if cfg.gradient == GradientMode::Exact {
+            // Exact J(θ⁰) needs no reference batch.
+            options.reference_batch = 0;
+        }
         Ok(PolicySolver {
             algorithm: cfg.algorithm,
             n: cfg.n_trajectories,
             dims: (cfg.v0.len(), cfg.sigma0.len()),
             constants,
+            options,
             source,
             certified: config.certified(),
         })
@@ -148,6 +159,8 @@ impl PolicySolver {
     /// The solver of `config` with every batch collected by `collector` and estimated by
     /// [`BlockEstimator`]: the same iteration code as [`PolicySolver::new`] in the sampled
     /// mode, so a collector that reproduces the built-in rollouts reproduces their records.
+    /// SEPG runs with the default [`SepgOptions`] (including the reference batch of J(θ⁰),
+    /// requested from the collector as [`Block::Reference`](crate::core::seed::Block)).
     ///
     /// # Errors
     /// A [`ConfigError`] for bad hyper-parameters, δ ∉ (0, 1), N too small for the blocks, or
@@ -174,6 +187,7 @@ impl PolicySolver {
             n: config.n_trajectories,
             dims,
             constants: config.constants,
+            options: SepgOptions::default(),
             source: Box::new(CollectedSource::new(
                 collector,
                 config.seed,
@@ -208,6 +222,7 @@ impl Solver for PolicySolver {
                 req,
                 false,
                 self.n,
+                &self.options,
                 state,
                 self.certified,
             ),
@@ -217,6 +232,7 @@ impl Solver for PolicySolver {
                 req,
                 true,
                 self.n,
+                &self.options,
                 state,
                 self.certified,
             ),

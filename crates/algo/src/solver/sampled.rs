@@ -12,7 +12,9 @@ use sepg_mdp::rollout::{rollout_into, rollout_returns_into};
 
 use crate::core::error::RunError;
 use crate::core::seed::Block;
-use crate::solver::source::{Estimate as BlockEstimate, Grad, GradientSource, Need, Query};
+use crate::solver::source::{
+    Estimate as BlockEstimate, Grad, GradientSource, Need, Query, SurrogateParts,
+};
 
 fn ee(e: sepg_estimators::EstimatorError) -> RunError {
     RunError::Estimator(e.to_string())
@@ -58,7 +60,8 @@ impl std::fmt::Debug for BlockEstimator {
     }
 }
 
-/// The Student-t width factors `t(1 − δ/2, n − 1)/√n` of the sample sizes seen so far.
+/// The Student-t width factors `factor · t(1 − δ/2, n − 1)/√n` of the sample sizes seen so
+/// far (`factor` = 0 turns every width off, the confidence option `none`).
 ///
 /// One iteration estimates from blocks of different sizes (34 and 33 trajectories for
 /// N = 100 split in three), so the factor of each size is kept instead of recomputing the
@@ -66,6 +69,7 @@ impl std::fmt::Debug for BlockEstimator {
 #[derive(Debug, Clone, Default)]
 struct StudentT {
     delta: f64,
+    factor: f64,
     scales: Vec<(usize, f64)>,
 }
 
@@ -75,9 +79,12 @@ impl StudentT {
     ///
     /// # Formula
     /// ```text
-    /// scale(n) = t(1 − δ/2, n − 1) / √n,    ε_i = scale(n) · √Var_i
+    /// scale(n) = factor · t(1 − δ/2, n − 1) / √n,    ε_i = scale(n) · √Var_i
     /// ```
     fn scale(&mut self, n: usize) -> Result<f64, RunError> {
+        if self.factor == 0.0 {
+            return Ok(0.0);
+        }
         if let Some(&(_, s)) = self.scales.iter().find(|(m, _)| *m == n) {
             return Ok(s);
         }
@@ -89,7 +96,7 @@ impl StudentT {
         let nf = n as f64;
         let t = student_t_quantile(1.0 - 0.5 * self.delta, nf - 1.0)
             .map_err(|e| RunError::Estimator(e.to_string()))?;
-        let s = t / nf.sqrt();
+        let s = self.factor * t / nf.sqrt();
         self.scales.push((n, s));
         Ok(s)
     }
@@ -102,6 +109,35 @@ impl StudentT {
             eps: e.variance().iter().map(|v| scale * v.sqrt()).collect(),
         })
     }
+
+    /// The one-sided upper confidence width of a mean of `n` samples with sample variance
+    /// `var`: J ≤ Ĵ + width with probability about 1 − δ.
+    ///
+    /// # Formula
+    /// ```text
+    /// width = factor · t(1 − δ, n − 1) · √(var / n)
+    /// ```
+    fn one_sided(&self, n: usize, var: f64) -> Result<f64, RunError> {
+        if self.factor == 0.0 {
+            return Ok(0.0);
+        }
+        if n < 2 {
+            return Err(RunError::Estimator(format!(
+                "a confidence width needs at least 2 trajectories, got {n}"
+            )));
+        }
+        let nf = n as f64;
+        let t = student_t_quantile(1.0 - self.delta, nf - 1.0)
+            .map_err(|e| RunError::Estimator(e.to_string()))?;
+        Ok(self.factor * t * (var / nf).sqrt())
+    }
+}
+
+/// Unbiased sample variance of `x` (n ≥ 2).
+fn sample_variance(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)
 }
 
 impl SampledSource {
@@ -110,6 +146,7 @@ impl SampledSource {
         horizon: usize,
         seed: u64,
         delta: f64,
+        confidence_factor: f64,
         spec: GradientSpec,
         constants: TaskConstants,
     ) -> Self {
@@ -119,7 +156,8 @@ impl SampledSource {
             seed,
             batch: Batch::zeros(0, 0, 0, 0, 0.0),
             returns: Vec::new(),
-            estimator: BlockEstimator::new(delta, spec, constants),
+            estimator: BlockEstimator::new(delta, spec, constants)
+                .with_confidence_factor(confidence_factor),
         }
     }
 }
@@ -138,9 +176,18 @@ impl BlockEstimator {
             dc: Vec::new(),
             widths: StudentT {
                 delta,
+                factor: 1.0,
                 scales: Vec::new(),
             },
         }
+    }
+
+    /// The same estimator with every width multiplied by `factor` ≥ 0 (the confidence
+    /// option: 1 is the Student-t width of Section 4.5, 0 turns the widths off).
+    pub fn with_confidence_factor(mut self, factor: f64) -> Self {
+        self.widths.factor = factor;
+        self.widths.scales.clear();
+        self
     }
 
     /// Ĵ and the gradients `need` asks for, from `batch`.
@@ -156,15 +203,20 @@ impl BlockEstimator {
     /// cannot be evaluated.
     pub fn estimate(&mut self, batch: &Batch, need: Need) -> Result<BlockEstimate, RunError> {
         if !(need.grad_v || need.grad_wj || need.grad_wl) {
-            let j = (0..batch.n)
-                .map(|i| batch.discounted_return(i))
-                .sum::<f64>()
-                / batch.n as f64;
+            let returns: Vec<f64> = (0..batch.n).map(|i| batch.discounted_return(i)).collect();
+            let j = returns.iter().sum::<f64>() / batch.n as f64;
+            let j_width = if need.j_width {
+                self.widths.one_sided(batch.n, sample_variance(&returns))?
+            } else {
+                0.0
+            };
             return Ok(BlockEstimate {
                 j,
                 grad_v: None,
                 grad_wj: None,
                 grad_wl: None,
+                parts: None,
+                j_width,
                 trajectories: batch.n as u64,
                 steps: batch.steps() as u64,
             });
@@ -183,11 +235,22 @@ impl BlockEstimator {
             .grad_wl
             .then(|| self.surrogate_grad(batch))
             .transpose()?;
+        let parts = need.grad_wl.then(|| SurrogateParts {
+            grad_v: self.surrogate.grad_v().mean().to_vec(),
+            mixed_sigma: self.surrogate.mixed().mean().to_vec(),
+        });
+        let j_width = if need.j_width {
+            self.widths.one_sided(batch.n, self.value.variance()[0])?
+        } else {
+            0.0
+        };
         Ok(BlockEstimate {
             j,
             grad_v,
             grad_wj,
             grad_wl,
+            parts,
+            j_width,
             trajectories: batch.n as u64,
             steps: batch.steps() as u64,
         })
@@ -242,6 +305,13 @@ impl GradientSource for SampledSource {
             )
             .map_err(me)?;
             let j = self.returns.iter().sum::<f64>() / q.n as f64;
+            let j_width = if q.need.j_width {
+                self.estimator
+                    .widths
+                    .one_sided(q.n, sample_variance(&self.returns))?
+            } else {
+                0.0
+            };
             let limit = self
                 .env
                 .time_limit()
@@ -251,6 +321,8 @@ impl GradientSource for SampledSource {
                 grad_v: None,
                 grad_wj: None,
                 grad_wl: None,
+                parts: None,
+                j_width,
                 trajectories: q.n as u64,
                 steps: (q.n * limit) as u64,
             });
@@ -362,6 +434,7 @@ mod tests {
         let policy = GaussianPolicy::new(vec![-0.3], vec![0.2], 1).expect("policy");
         let mut widths = StudentT {
             delta: 0.2,
+            factor: 1.0,
             scales: Vec::new(),
         };
         let mut estimator = Estimator::new();

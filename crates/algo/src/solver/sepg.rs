@@ -1,6 +1,7 @@
 //! One iteration of SEPG (Algorithm 4.3 with the delayed budget updates of Sec 4.4.4).
 use crate::core::config::Requirement;
 use crate::core::error::RunError;
+use crate::core::options::{Lb1Requirement, SepgOptions};
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
@@ -57,18 +58,67 @@ fn min_sigma(w: &[f64]) -> f64 {
     w.iter().fold(f64::INFINITY, |m, &wi| m.min(wi.exp()))
 }
 
+/// Before the first iteration of LB-I and the type-II requirements, estimates J(θ⁰) from a
+/// reference batch of `opts.reference_batch` trajectories and stores its upper confidence
+/// bound Û⁰ = Ĵ⁰ + ε₀ as LB-I's J(θ⁰) and as the reference of the budget's first exploratory
+/// difference; with a deterministic target (ZV, SIM-ν) the first target is treated likewise.
+/// On the events J(θ⁰) ≤ Û⁰ (probability ≥ 1 − δ each) the requirements built on J(θ⁰)
+/// are at least as strict as with the exact value (docs/THEOREMS.md).
+fn reference(
+    source: &mut dyn GradientSource,
+    req: Requirement,
+    opts: &SepgOptions,
+    state: &mut State,
+) -> Result<(), RunError> {
+    if state.j0.is_some() || opts.reference_batch == 0 || req == Requirement::Mi {
+        return Ok(());
+    }
+    let need = Need {
+        j_width: true,
+        ..Need::default()
+    };
+    let mut upper = |block, w: Option<&[f64]>, state: &mut State| -> Result<f64, RunError> {
+        let e = source.estimate(&Query {
+            iteration: state.iteration,
+            block,
+            v: &state.v,
+            w,
+            n: opts.reference_batch,
+            need,
+        })?;
+        state.trajectories += e.trajectories;
+        state.steps += e.steps;
+        Ok(e.j + e.j_width)
+    };
+    let w = state.w.clone();
+    let j0 = upper(Block::Reference, Some(&w), state)?;
+    state.j0 = Some(j0);
+    if req.is_type_two() {
+        state.pending = Some(j0);
+    }
+    if matches!(req, Requirement::Zv | Requirement::Sim { .. }) {
+        state.target_prev = Some(upper(Block::ReferenceTarget, None, state)?);
+    }
+    Ok(())
+}
+
 /// Runs SEPG iteration `state.iteration` for `req`; `naive_w` selects the w-update along
 /// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20); `certify` selects certified steps
-/// (`sepg_bounds::certified`).
+/// (`sepg_bounds::certified`); `opts` the remaining choices ([`SepgOptions`]).
 pub(crate) fn iterate(
     source: &mut dyn GradientSource,
     k: &TaskConstants,
     req: Requirement,
     naive_w: bool,
     n: usize,
+    opts: &SepgOptions,
     state: &mut State,
     certify: bool,
 ) -> Result<Record, RunError> {
+    reference(source, req, opts, state)?;
+    if opts.alternating {
+        return iterate_alternating(source, k, req, naive_w, n, opts, state, certify);
+    }
     let t = state.iteration;
     let sizes = split(n, req.blocks());
     let budget_error = |_| RunError::NonFinite {
@@ -81,6 +131,7 @@ pub(crate) fn iterate(
         grad_v: false,
         grad_wj: true,
         grad_wl: !naive_w,
+        j_width: false,
     };
     let sim_nu = match req {
         Requirement::Sim { nu } => Some(nu),
@@ -93,6 +144,7 @@ pub(crate) fn iterate(
         grad_v: true,
         grad_wj: sim || req == Requirement::Lv,
         grad_wl: sim && !naive_w,
+        j_width: false,
     };
     let ev = source.estimate(&Query {
         iteration: t,
@@ -122,9 +174,14 @@ pub(crate) fn iterate(
     let sigma = min_sigma(&state.w);
     // Type-I requirement Cᵗ (Table 4.1) split (1 − ν)C / νC (eqs. 4.13, 4.14); SIM-ν splits
     // the budget νB / (1 − ν)B (Sec 5.1.3); other type-II updates use C = −B.
+    // With `Lb1Requirement::Full` the v-update gets all of Cᵗ and the w-update its own
+    // requirement J(θ⁰) − J(vᵗ⁺¹, wᵗ), measured by the w-block.
+    let full = opts.lb1_requirement == Lb1Requirement::Full;
     let type_one = match req {
         Requirement::Mi => Some(split_requirement(0.0, 0.0)),
-        Requirement::LbI { nu } => Some(split_requirement(j_base - j_t, nu)),
+        Requirement::LbI { nu } => {
+            Some(split_requirement(j_base - j_t, if full { 0.0 } else { nu }))
+        }
         _ => None,
     }
     .transpose()
@@ -139,6 +196,10 @@ pub(crate) fn iterate(
     ))?;
     let v_plan = steps::v_step(k, sigma, grad_v, required_v, certify)?;
     let v_log = BlockLog::from_plan(&v_plan);
+    let alpha = match v_plan {
+        Plan::Update(s) => s.size,
+        Plan::BelowNoise => 0.0,
+    };
     let mut v_new = state.v.clone();
     apply(&mut v_new, &v_plan);
 
@@ -183,7 +244,7 @@ pub(crate) fn iterate(
     let mut w_new = state.w.clone();
     let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
         let required_w = -(1.0 - nu) * budget.value();
-        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w, certify)?;
+        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w, certify, opts, alpha)?;
         apply(&mut w_new, &plan);
         (None, required_w, BlockLog::from_plan(&plan), j_t)
     } else {
@@ -199,8 +260,11 @@ pub(crate) fn iterate(
         env_steps += ew.steps;
         // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
         budget.record_exploratory(ew.j).map_err(budget_error)?;
-        let required_w = type_one.map_or(budget.required_improvement(), |(_, cw)| cw);
-        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w, certify)?;
+        let required_w = match (req, full) {
+            (Requirement::LbI { .. }, true) => j_base - ew.j,
+            _ => type_one.map_or(budget.required_improvement(), |(_, cw)| cw),
+        };
+        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w, certify, opts, alpha)?;
         apply(&mut w_new, &plan);
         (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
     };
@@ -253,10 +317,119 @@ pub(crate) fn iterate(
     }
     state.trajectories = trajectories;
     state.steps = env_steps;
+    state.last_alpha = Some(alpha);
     Ok(record)
 }
 
-/// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `naive`).
+/// One half-iteration of alternating SEPG-MI or SEPG-LB-I (the thesis-era code's schedule):
+/// even iterations update v, odd ones w, each from one batch of all `n` trajectories, with
+/// the requirement measured at its own start (LB-I: J(θ⁰) − Ĵ, times 1 − ν or ν unless
+/// `Lb1Requirement::Full`). Each half-step keeps J ≥ J(θ⁰) on its own, since
+/// J_after ≥ J_before + ν(J(θ⁰) − J_before) ≥ J(θ⁰) whenever J_before ≥ J(θ⁰).
+fn iterate_alternating(
+    source: &mut dyn GradientSource,
+    k: &TaskConstants,
+    req: Requirement,
+    naive_w: bool,
+    n: usize,
+    opts: &SepgOptions,
+    state: &mut State,
+    certify: bool,
+) -> Result<Record, RunError> {
+    let t = state.iteration;
+    let v_turn = t.is_multiple_of(2);
+    let e = source.estimate(&Query {
+        iteration: t,
+        block: if v_turn { Block::V } else { Block::W },
+        v: &state.v,
+        w: Some(&state.w),
+        n,
+        need: Need {
+            grad_v: v_turn,
+            grad_wj: !v_turn,
+            grad_wl: !v_turn && !naive_w,
+            j_width: false,
+        },
+    })?;
+    let j_base = *state.j0.get_or_insert(e.j);
+    let share = match (req, opts.lb1_requirement) {
+        (Requirement::LbI { .. }, Lb1Requirement::Full) => 1.0,
+        (Requirement::LbI { nu }, Lb1Requirement::Split) => {
+            if v_turn {
+                1.0 - nu
+            } else {
+                nu
+            }
+        }
+        _ => 0.0,
+    };
+    let required = share * (j_base - e.j);
+    let sigmas = state.sigma();
+    let (mut v_new, mut w_new) = (state.v.clone(), state.w.clone());
+    let plan = if v_turn {
+        let g = e.grad_v.as_ref().ok_or(RunError::Estimator(
+            "the v-block returned no gradient".into(),
+        ))?;
+        let plan = steps::v_step(k, min_sigma(&state.w), g, required, certify)?;
+        apply(&mut v_new, &plan);
+        state.last_alpha = Some(match plan {
+            Plan::Update(s) => s.size,
+            Plan::BelowNoise => 0.0,
+        });
+        plan
+    } else {
+        let alpha = state.last_alpha.unwrap_or(0.0);
+        let plan = w_plan(k, &sigmas, &e, required, naive_w, certify, opts, alpha)?;
+        apply(&mut w_new, &plan);
+        plan
+    };
+    if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
+        return Err(RunError::NonFinite {
+            what: "policy parameters",
+            iteration: t,
+        });
+    }
+    let log = BlockLog::from_plan(&plan);
+    let idle = BlockLog::default();
+    let (v_log, w_log) = if v_turn { (log, idle) } else { (idle, log) };
+    state.trajectories += e.trajectories;
+    state.steps += e.steps;
+    let record = Record {
+        iteration: t,
+        v: state.v.clone(),
+        w: state.w.clone(),
+        sigma: sigmas,
+        j_exploratory: e.j,
+        j_after_v: None,
+        j_target: e.j,
+        w_target: Some(state.w.clone()),
+        budget: state.budget,
+        required_v: v_turn.then_some(required),
+        required_w: (!v_turn).then_some(required),
+        alpha: v_log.size,
+        beta: w_log.size,
+        lambda_v: v_log.lambda,
+        lambda_w: w_log.lambda,
+        guaranteed_v: v_log.guaranteed,
+        guaranteed_w: w_log.guaranteed,
+        infeasible_v: v_log.infeasible,
+        infeasible_w: w_log.infeasible,
+        below_noise_v: v_log.below_noise,
+        below_noise_w: w_log.below_noise,
+        certified_v: v_log.certified,
+        certified_w: w_log.certified,
+        trajectories: state.trajectories,
+        steps: state.steps,
+    };
+    state.iteration += 1;
+    state.v = v_new;
+    state.w = w_new;
+    Ok(record)
+}
+
+/// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `naive`), along the
+/// direction and in the form `opts` selects; `alpha` is the latest v-step size (for the
+/// metagradient direction).
 fn w_plan(
     k: &TaskConstants,
     sigmas: &[f64],
@@ -264,14 +437,25 @@ fn w_plan(
     required: f64,
     naive: bool,
     certify: bool,
+    opts: &SepgOptions,
+    alpha: f64,
 ) -> Result<Plan, RunError> {
     let missing = || RunError::Estimator("the w-block returned no w-gradient".into());
     let gj = e.grad_wj.as_ref().ok_or_else(missing)?;
     if naive {
         steps::w_step_naive(k, sigmas, gj, required, certify)
     } else {
-        let gl = e.grad_wl.as_ref().ok_or_else(missing)?;
-        steps::w_step_surrogate(k, sigmas, gl, gj, required, certify)
+        let cross = e.grad_wl.as_ref().ok_or_else(missing)?;
+        let gl = steps::w_direction(
+            k,
+            sigmas,
+            opts.w_direction,
+            cross,
+            e.parts.as_ref(),
+            gj,
+            alpha,
+        )?;
+        steps::w_step_surrogate(k, sigmas, &gl, gj, required, certify, opts.w_step)
     }
 }
 

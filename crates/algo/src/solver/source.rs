@@ -28,8 +28,21 @@ pub struct Need {
     pub grad_v: bool,
     /// ∇_w J.
     pub grad_wj: bool,
-    /// ∇_w L (surrogate of Corollary 4.4).
+    /// ∇_w L (surrogate of Corollary 4.4), with the plug-in ingredients of other w-directions
+    /// ([`Estimate::parts`]).
     pub grad_wl: bool,
+    /// A one-sided upper confidence width of Ĵ ([`Estimate::j_width`]).
+    pub j_width: bool,
+}
+
+/// Full-batch estimates from which the plug-in w-directions are assembled: ∇_v J and
+/// ∂_σ ∇_v J (component `j · dim_v + k` for action j and mean parameter k).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurrogateParts {
+    /// ∇_v J.
+    pub grad_v: Vec<f64>,
+    /// ∂_{σ_j} ∇_v J.
+    pub mixed_sigma: Vec<f64>,
 }
 
 /// One evaluation of a policy by a block.
@@ -60,6 +73,11 @@ pub struct Estimate {
     pub grad_wj: Option<Grad>,
     /// ∇_w L if requested.
     pub grad_wl: Option<Grad>,
+    /// With ∇_w L: the ingredients of its plug-in form and of the metagradient.
+    pub parts: Option<SurrogateParts>,
+    /// If requested: ε_J ≥ 0 with J ≤ Ĵ + ε_J at confidence 1 − δ (one-sided Student-t times
+    /// the confidence factor; 0 for exact values and without confidence widths).
+    pub j_width: f64,
     /// Trajectories used.
     pub trajectories: u64,
     /// Environment steps used.

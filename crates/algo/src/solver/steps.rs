@@ -7,13 +7,15 @@
 //! bound, evaluated in interval arithmetic, meets the requirement.
 use sepg_bounds::certified::{self, Certified};
 use sepg_bounds::constants::{TaskConstants, c};
+use sepg_bounds::exploring::{ExploringBound, w_exploring_step};
 use sepg_bounds::greedy::argmax_abs;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{BoundsError, pirotta, surrogate, v_update, w_update};
 
 use crate::core::error::RunError;
-use crate::solver::source::Grad;
+use crate::core::options::{WDirection, WStep};
+use crate::solver::source::{Grad, SurrogateParts};
 
 const FORM: HpForm = HpForm::SignAware;
 
@@ -141,8 +143,9 @@ pub fn v_step(
 }
 
 /// The greedy-coordinate w-update along ∇_w L with the largest safe β̄ (Theorem 4.5,
-/// eq. 4.19; Theorem 4.9, eq. 4.30 when estimated), coordinate h = argmax |∇_{w_j} L| with
-/// d at σ_h.
+/// eq. 4.19, for exact gradients), coordinate h = argmax |∇_{w_j} L| with d at σ_h. Estimated
+/// gradients use the exploring w-update (`sepg_bounds::exploring`, the confidence of ∇̂_w J
+/// only) or Theorem 4.9 (eq. 4.30), as `form` says.
 pub fn w_step_surrogate(
     k: &TaskConstants,
     sigmas: &[f64],
@@ -150,10 +153,18 @@ pub fn w_step_surrogate(
     gj: &Grad,
     required: f64,
     certify: bool,
+    form: WStep,
 ) -> Result<Plan, RunError> {
     let h = argmax_abs(&gl.value).map_err(be)?;
     let (s, l, j) = (sigmas[h], gl.value[h], gj.value[h]);
     let exact = is_exact(gl) && is_exact(gj);
+    if form == WStep::Exploring && !exact {
+        // The exploring w-update (not yet certified in interval arithmetic).
+        let ej = gj.eps[h];
+        let bound = ExploringBound::new(k, s, j, ej).map_err(be)?;
+        let outcome = w_exploring_step(k, s, j, ej, l, required).map_err(be)?;
+        return plan_from(outcome, h, l, |b| bound.value(b * l));
+    }
     if certify {
         if exact && l == 0.0 {
             return Ok(Plan::BelowNoise);
@@ -179,6 +190,67 @@ pub fn w_step_surrogate(
         };
         let outcome = hp::w_safe_step_along_l(k, s, j, ej, l, el, required, FORM).map_err(be)?;
         plan_from(outcome, h, l, |x| b.sign_aware_value(x))
+    }
+}
+
+/// The direction of the w-update (`WDirection`): the cross-fitted ∇̂_w L itself, the
+/// plug-in ∇̂_w L assembled from full-batch means, or the thesis-era metagradient with the
+/// step size `alpha` of the latest v-update (scalar action).
+///
+/// # Formula
+/// ```text
+/// plug-in:      ∇_{w_j} L from ∇̂_v J and ∂̂_{w_j}∇_v J = σ_j ∂̂_{σ_j}∇_v J   (surrogate_grad_w)
+/// metagradient: ∇̂_w J + 2α‖∇̂_v J‖² + clip(2σα⟨∇̂_v J, ∂̂_σ∇_v J⟩, −clip, clip)
+/// ```
+///
+/// The plug-in direction keeps the widths of the cross-fitted estimate; the metagradient has
+/// width 0 (its scale is that of J, not of L). Only the exploring step and Theorem 4.9 read
+/// these widths, and the exploring step ignores them.
+pub fn w_direction(
+    k: &TaskConstants,
+    sigmas: &[f64],
+    direction: WDirection,
+    cross_fitted: &Grad,
+    parts: Option<&SurrogateParts>,
+    gj: &Grad,
+    alpha: f64,
+) -> Result<Grad, RunError> {
+    let parts = || {
+        parts.ok_or_else(|| RunError::Estimator("the w-block returned no surrogate parts".into()))
+    };
+    match direction {
+        WDirection::CrossFitted => Ok(cross_fitted.clone()),
+        WDirection::PlugIn => {
+            let p = parts()?;
+            let m = p.grad_v.len();
+            let mixed_wv: Vec<f64> = p
+                .mixed_sigma
+                .iter()
+                .enumerate()
+                .map(|(i, x)| x * sigmas[i / m.max(1)])
+                .collect();
+            Ok(Grad {
+                value: surrogate_grad_w(k, &p.grad_v, &mixed_wv, sigmas)?,
+                eps: cross_fitted.eps.clone(),
+            })
+        }
+        WDirection::Metagradient { clip } => {
+            let p = parts()?;
+            let norm2: f64 = p.grad_v.iter().map(|g| g * g).sum();
+            let inner: f64 = p
+                .grad_v
+                .iter()
+                .zip(&p.mixed_sigma)
+                .map(|(g, x)| g * x)
+                .sum();
+            let value = gj.value[0]
+                + 2.0 * alpha * norm2
+                + (2.0 * sigmas[0] * alpha * inner).clamp(-clip, clip);
+            if !value.is_finite() {
+                return Err(RunError::Estimator("the metagradient is not finite".into()));
+            }
+            Ok(Grad::exact(vec![value]))
+        }
     }
 }
 

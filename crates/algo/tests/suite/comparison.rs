@@ -7,6 +7,7 @@
 //! found here by golden-section search on the oracle; it differs from the infinite-horizon
 //! v* of SPEC §1 because of the horizon. Sampled checks use fixed seeds.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_mdp::env::AnyEnv;
 use sepg_mdp::oracle::{ClosedFormOracle, ExactOracle, Exploration, Horizon};
@@ -263,7 +264,9 @@ fn lv_and_sim_sanity_sampled() {
     };
     let (records, state) = run(cfg, 3000);
     assert!(records.iter().all(|r| r.j_after_v.is_none()));
-    assert_eq!(records[9].trajectories, 1000);
+    // N per iteration, plus the reference batches of J(θ⁰) and of the first target.
+    let reference = SepgOptions::default().reference_batch as u64;
+    assert_eq!(records[9].trajectories, 1000 + 2 * reference);
     let err = (state.v[0] - v_star()).abs();
     assert!(err < 0.2, "SIM: |v − v*| = {err}");
     let cfg = SepgConfig {

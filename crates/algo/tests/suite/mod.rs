@@ -6,6 +6,7 @@ mod config;
 mod determinism;
 mod exact;
 mod mountain_car;
+mod options;
 mod plumbing;
 mod safety;
 mod sampled;

@@ -15,6 +15,7 @@
 //! The short test runs in a few seconds; the per-seed study is `#[ignore]`d (about 6
 //! minutes): `cargo test -p sepg-algo --release --test lib -- --ignored --nocapture mountain`.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_mdp::env::Preset;
 use sepg_mdp::mountain_car::TIME_LIMIT;
@@ -55,7 +56,12 @@ fn zv_keeps_sigma_while_adam_shrinks_it() {
         crate::suite::common::run(config(Algorithm::Sepg(Requirement::Zv), 0), iterations);
     let (adam, adam_end) =
         crate::suite::common::run(config(Algorithm::adam(1e-3, 1e-3), 0), iterations);
-    assert_eq!(zv.last().map(|r| r.trajectories), Some(N * iterations));
+    // N per iteration, plus the reference batches of J(θ⁰) and of the first target.
+    let reference = SepgOptions::default().reference_batch as u64;
+    assert_eq!(
+        zv.last().map(|r| r.trajectories),
+        Some(N * iterations + 2 * reference)
+    );
     // Adam: ∇̂_w J < 0 at every iteration (its standard error is ~5 % of its size), so every
     // Adam step lowers w by about the learning rate.
     for (a, b) in adam.iter().zip(adam.iter().skip(1)) {

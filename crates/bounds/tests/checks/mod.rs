@@ -1,6 +1,7 @@
 mod batch_budget;
 mod common;
 mod errors;
+mod exploring;
 mod high_probability;
 mod interval;
 mod intervals;

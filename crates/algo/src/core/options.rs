@@ -1,0 +1,193 @@
+//! Options of SEPG beyond the thesis's pseudocode: the default, exploring and guaranteed
+//! choices, and the choices of the thesis-era public code (potion, `algorithms/safe.py`,
+//! January 2019) that reproduce the published numbers without their guarantee.
+//!
+//! | option | default | thesis-era code |
+//! |---|---|---|
+//! | [`SepgOptions::w_step`] | [`WStep::Exploring`] | (δ = 1 makes both forms Theorem 4.5) |
+//! | [`SepgOptions::w_direction`] | [`WDirection::CrossFitted`] | [`WDirection::Metagradient`] |
+//! | [`SepgOptions::confidence`] | Student-t, factor 1 | [`Confidence::None`] (δ = 1), or factor 2 |
+//! | [`SepgOptions::lb1_requirement`] | [`Lb1Requirement::Split`] | [`Lb1Requirement::Full`] |
+//! | [`SepgOptions::alternating`] | `false` | `true` |
+//! | [`SepgOptions::reference_batch`] | 1000 | 0 |
+//! | [`SepgOptions::overrides`] | none | γ = 0.9 in its script |
+use serde::{Deserialize, Serialize};
+
+use crate::core::error::ConfigError;
+
+/// How the w-update turns its estimates into a safe step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum WStep {
+    /// The exploring w-update (docs/THEOREMS.md, `sepg_bounds::exploring`): the step goes
+    /// as far along the chosen direction as the bound of Theorem 4.3 with the confidence on
+    /// ∇_w J alone allows. The width of the direction's estimate plays no role.
+    #[default]
+    Exploring,
+    /// Theorem 4.9 in the sign-aware form: corrected norms L⁻J⁻, no update when the direction
+    /// is within its confidence width (eq. 4.23).
+    Theorem49,
+}
+
+/// The direction of the w-update.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum WDirection {
+    /// ∇̂_w L, cross-fitted on two halves of the batch (unbiased, `sepg_estimators`).
+    #[default]
+    CrossFitted,
+    /// ∇̂_w L from full-batch plug-in products ‖∇̂_v J‖² and ⟨∇̂_v J, ∂̂_σ∇_v J⟩, biased
+    /// upwards by the variance of ∇̂_v J.
+    PlugIn,
+    /// The thesis-era code's direction: the w-derivative of J + α‖∇_v J‖² with α the step
+    /// size of the latest v-update (scalar actions only):
+    /// `∇̂_w J + 2α‖∇̂_v J‖² + clip(2σα⟨∇̂_v J, ∂̂_σ∇_v J⟩, ±clip)`.
+    Metagradient {
+        /// The clipping threshold of the last term (100 in the thesis-era code).
+        clip: f64,
+    },
+}
+
+/// The confidence widths ε of the sampled mode (Section 4.5).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Confidence {
+    /// ε = 0: the estimates are used as if exact (the thesis-era code's default δ = 1).
+    None,
+    /// ε_i = factor · t(1 − δ/2, N − 1) · √(Var_i/N); the thesis-era code used factor 2.
+    StudentT {
+        /// Multiplier of the Student-t quantile (> 0).
+        factor: f64,
+    },
+}
+
+impl Default for Confidence {
+    fn default() -> Self {
+        Confidence::StudentT { factor: 1.0 }
+    }
+}
+
+impl Confidence {
+    /// The multiplier of every confidence width: 0 for [`Confidence::None`].
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::Confidence;
+    /// assert_eq!(Confidence::None.factor(), 0.0);
+    /// assert_eq!(Confidence::default().factor(), 1.0);
+    /// ```
+    pub fn factor(self) -> f64 {
+        match self {
+            Confidence::None => 0.0,
+            Confidence::StudentT { factor } => factor,
+        }
+    }
+}
+
+/// How LB-I's requirement C = J(θ⁰) − J is shared between the two half-steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Lb1Requirement {
+    /// (1 − ν)Cᵗ for the v-update and νCᵗ for the w-update, Cᵗ = J(θ⁰) − J(θᵗ)
+    /// (eqs. 4.13, 4.14).
+    #[default]
+    Split,
+    /// Each half-step gets the whole requirement measured at its own start:
+    /// J(θ⁰) − J(vᵗ, wᵗ) for the v-update, J(θ⁰) − J(vᵗ⁺¹, wᵗ) for the w-update.
+    Full,
+}
+
+/// Overrides of the task constants R, M_φ, |A| and γ that the bounds use.
+///
+/// `gamma` also changes the environment's discount, so J itself changes; the others only
+/// change the bounds (they must stay valid bounds for the guarantees to hold).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ConstantOverrides {
+    /// Discount factor γ ∈ [0, 1).
+    pub gamma: Option<f64>,
+    /// Maximal absolute reward R.
+    pub r_max: Option<f64>,
+    /// Maximal absolute feature M_φ.
+    pub m_phi: Option<f64>,
+    /// Action-space volume |A|.
+    pub action_volume: Option<f64>,
+}
+
+/// SEPG options (see the module documentation for the defaults and the thesis-era values).
+///
+/// # Examples
+/// ```
+/// use sepg_algo::core::options::{SepgOptions, WStep};
+/// let o = SepgOptions::default();
+/// assert_eq!(o.w_step, WStep::Exploring);
+/// assert_eq!(o.reference_batch, 1000);
+/// assert!(o.validate().is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SepgOptions {
+    /// The form of the w-update.
+    pub w_step: WStep,
+    /// The direction of the w-update.
+    pub w_direction: WDirection,
+    /// The confidence widths of the sampled mode.
+    pub confidence: Confidence,
+    /// LB-I's requirement per half-step.
+    pub lb1_requirement: Lb1Requirement,
+    /// Alternate v-iterations and w-iterations, each with all N trajectories (MI and LB-I
+    /// only), instead of a v-block and a w-block in every iteration.
+    pub alternating: bool,
+    /// N₀ trajectories of a reference batch that estimates J(θ⁰) (and the first target's J)
+    /// before the first iteration of LB-I and the type-II requirements, used through its
+    /// upper confidence bound Ĵ⁰ + ε₀ (one-sided, level δ); 0 takes J(θ⁰) from the first
+    /// v-block with no confidence bound (the thesis's pseudocode). Sampled mode only.
+    pub reference_batch: usize,
+    /// Overrides of γ, R, M_φ, |A|.
+    pub overrides: ConstantOverrides,
+}
+
+impl Default for SepgOptions {
+    fn default() -> Self {
+        SepgOptions {
+            w_step: WStep::Exploring,
+            w_direction: WDirection::CrossFitted,
+            confidence: Confidence::default(),
+            lb1_requirement: Lb1Requirement::Split,
+            alternating: false,
+            reference_batch: 1000,
+            overrides: ConstantOverrides::default(),
+        }
+    }
+}
+
+impl SepgOptions {
+    /// Checks the domains of the options that carry numbers.
+    ///
+    /// # Errors
+    /// [`ConfigError::InvalidHyperParameter`] for a quantile factor that is not finite and
+    /// positive, a clipping threshold that is not finite and positive, or a reference batch
+    /// of 1 trajectory (a width needs 2).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::{Confidence, SepgOptions};
+    /// let bad = SepgOptions { confidence: Confidence::StudentT { factor: 0.0 }, ..Default::default() };
+    /// assert!(bad.validate().is_err());
+    /// ```
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |name, value: f64, domain| ConfigError::InvalidHyperParameter {
+            name,
+            value,
+            domain,
+        };
+        if let Confidence::StudentT { factor } = self.confidence
+            && !(factor.is_finite() && factor > 0.0)
+        {
+            return Err(bad("confidence factor", factor, "(0, inf)"));
+        }
+        if let WDirection::Metagradient { clip } = self.w_direction
+            && !(clip.is_finite() && clip > 0.0)
+        {
+            return Err(bad("metagradient clip", clip, "(0, inf)"));
+        }
+        if self.reference_batch == 1 {
+            return Err(bad("reference batch", 1.0, "0 or at least 2"));
+        }
+        Ok(())
+    }
+}
