@@ -160,16 +160,18 @@ fn grad(value: &Bound<'_, PyAny>, eps: Option<&Bound<'_, PyAny>>, name: &str) ->
 /// high-probability version, Theorem 4.7, eq. (4.26), with ε = max_i ε_i otherwise.
 /// `sigma` is the smallest standard deviation of the policy.
 #[pyfunction]
-#[pyo3(signature = (constants, sigma, grad_v, eps = None, required = 0.0))]
+/// With `certify=True` the step is chosen with the certified (interval-arithmetic) bounds.
+#[pyo3(signature = (constants, sigma, grad_v, eps = None, required = 0.0, certify = false))]
 fn v_step(
     constants: PyRef<'_, PyTaskConstants>,
     sigma: f64,
     grad_v: &Bound<'_, PyAny>,
     eps: Option<&Bound<'_, PyAny>>,
     required: f64,
+    certify: bool,
 ) -> PyResult<PySafeStep> {
     let g = grad(grad_v, eps, "grad_v")?;
-    steps::v_step(&constants.0, sigma, &g, required)
+    steps::v_step(&constants.0, sigma, &g, required, certify)
         .map(PySafeStep)
         .map_err(run_err)
 }
@@ -180,7 +182,8 @@ fn v_step(
 /// (the naive update, Theorem 4.3, eq. 4.17; Theorem 4.8, eq. 4.29). `sigmas` are the
 /// standard deviations σ_j = e^{w_j}; the widths are per component or a scalar.
 #[pyfunction]
-#[pyo3(signature = (constants, sigmas, grad_w_j, grad_w_l = None, eps_j = None, eps_l = None, required = 0.0))]
+/// With `certify=True` the step is chosen with the certified (interval-arithmetic) bounds.
+#[pyo3(signature = (constants, sigmas, grad_w_j, grad_w_l = None, eps_j = None, eps_l = None, required = 0.0, certify = false))]
 #[allow(clippy::too_many_arguments)]
 fn w_step(
     constants: PyRef<'_, PyTaskConstants>,
@@ -190,6 +193,7 @@ fn w_step(
     eps_j: Option<&Bound<'_, PyAny>>,
     eps_l: Option<&Bound<'_, PyAny>>,
     required: f64,
+    certify: bool,
 ) -> PyResult<PySafeStep> {
     let sigmas = vector(sigmas, "sigmas")?;
     let gj = grad(grad_w_j, eps_j, "grad_w_j")?;
@@ -210,10 +214,10 @@ fn w_step(
                     sigmas.len()
                 )));
             }
-            steps::w_step_surrogate(&constants.0, &sigmas, &gl, &gj, required)
+            steps::w_step_surrogate(&constants.0, &sigmas, &gl, &gj, required, certify)
         }
         None if eps_l.is_some() => return Err(invalid("eps_l was given without grad_w_l")),
-        None => steps::w_step_naive(&constants.0, &sigmas, &gj, required),
+        None => steps::w_step_naive(&constants.0, &sigmas, &gj, required, certify),
     };
     plan.map(PySafeStep).map_err(run_err)
 }
