@@ -300,17 +300,18 @@ fn merge_folders(shards: Vec<PathBuf>, out: PathBuf, force: bool) -> PyResult<St
 }
 
 /// Re-checks the log of the run folder `dir` against its safety requirement (with the exact
-/// oracle where one exists) and returns the report as JSON text: every violation with its
-/// iteration, check, required and actual values.
+/// oracle where one exists) and returns the report as JSON text: one summary per check and
+/// every failing iteration with its check, required and actual values (`alpha`: family-wise
+/// level of the binomial tests of a sampled run).
 #[pyfunction]
-#[pyo3(signature = (dir, tolerance = 1e-9))]
-fn audit_folder(dir: PathBuf, tolerance: f64) -> PyResult<String> {
+#[pyo3(signature = (dir, tolerance = 1e-9, alpha = sepg_runs::audit::DEFAULT_ALPHA))]
+fn audit_folder(dir: PathBuf, tolerance: f64, alpha: f64) -> PyResult<String> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(format!(
             "tolerance = {tolerance} must be finite and non-negative"
         )));
     }
-    let report = sepg_runs::audit::audit(&dir, tolerance).map_err(|e| {
+    let report = sepg_runs::audit::audit(&dir, tolerance, alpha).map_err(|e| {
         if e.is_invalid_input() {
             invalid(e)
         } else {

@@ -62,7 +62,8 @@ def test_run_read_resume_and_audit(tmp_path):
     # A complete run resumes to itself; an exact-gradient MI run passes its audit.
     assert runs.resume(tmp_path / "r")["final"] == summary["final"]
     report = runs.audit(tmp_path / "r")
-    assert report["checks"] > 0 and report["violations"] == []
+    assert report["status"] == "holds" and report["failures"] == []
+    assert all(c["verdict"] == "holds" and c["checked"] > 0 for c in report["checks"])
 
 
 def test_run_options_and_folders_are_checked(tmp_path):

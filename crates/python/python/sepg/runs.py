@@ -177,10 +177,12 @@ def merge(shards: Sequence[PathLike], out: PathLike, *, force: bool = False) -> 
     return json.loads(_native.merge_folders([os.fspath(s) for s in shards], os.fspath(out), force))
 
 
-def audit(dir: PathLike, *, tolerance: float = 1e-9) -> Dict[str, Any]:
+def audit(dir: PathLike, *, tolerance: float = 1e-9, alpha: float = 0.01) -> Dict[str, Any]:
     """Re-checks the run folder's log against its safety requirement, as ``sepg audit``:
-    the report lists every violation (iteration, check, required, actual, shortfall)."""
-    return json.loads(_native.audit_folder(os.fspath(dir), tolerance))
+    the report has one summary per check (kind, checked, failed, worst shortfall, verdict),
+    every failing iteration (iteration, check, required, actual, shortfall) and the
+    ``status`` (``holds``, ``violated`` or ``incomplete``)."""
+    return json.loads(_native.audit_folder(os.fspath(dir), tolerance, alpha))
 
 
 def verify(*, quick: bool = True, check: Optional[str] = None, seed: int = 0) -> Dict[str, Any]:
