@@ -122,6 +122,34 @@ fn merged_shards_equal_the_unsharded_sweep_whatever_the_thread_count() {
     assert_eq!(m["runs"], u["runs"]);
     assert_eq!(m["shard"], u["shard"]);
     assert_eq!(m["merged_from"], 3);
+    // The merged summary.csv is the unsharded one, byte for byte, and each shard's lists its
+    // own runs only.
+    let table = std::fs::read_to_string(one.join("summary.csv")).expect("summary.csv");
+    assert_eq!(
+        std::fs::read_to_string(merged.join("summary.csv")).expect("summary.csv"),
+        table
+    );
+    let shard_rows: usize = shards
+        .iter()
+        .map(|s| {
+            std::fs::read_to_string(s.join("summary.csv"))
+                .expect("summary.csv")
+                .lines()
+                .count()
+                - 1
+        })
+        .sum();
+    assert_eq!(shard_rows, 16);
+    assert!(
+        table.lines().skip(1).all(|l| l.ends_with(",not-audited")),
+        "{table}"
+    );
+    // `sepg audit` on the sweep folder fills in the audit column.
+    let out = sepg(&["audit", one.to_str().expect("utf-8")]);
+    let table = std::fs::read_to_string(one.join("summary.csv")).expect("summary.csv");
+    summary_csv_matches_the_runs(&one, &table);
+    let expected = if table.contains(",violated") { 1 } else { 0 };
+    assert_eq!(out.status.code(), Some(expected), "{table}");
 
     // Merging an incomplete set of shards, or one shard twice, is refused.
     let out_bad = tmp.path().join("bad");
@@ -294,4 +322,61 @@ algo = "sepg-zv"
     assert!(err.contains(&expected), "{err}");
     assert!(err.contains("0 of 2 runs complete"), "{err}");
     assert!(!err.contains("sepg run --resume"), "{err}");
+}
+
+/// Checks each row of a sweep's `summary.csv` against the run it describes: settings from
+/// `sweep.json`, outcome from the run's `summary.json`, status from `sepg audit`.
+fn summary_csv_matches_the_runs(sweep: &Path, table: &str) {
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next(),
+        Some("preset,variant,algorithm,sigma0,seed,v,sigma,j,abs_v_error,infeasible,audit")
+    );
+    let runs = json(&sweep.join("sweep.json"))["runs"]
+        .as_array()
+        .expect("runs")
+        .clone();
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), runs.len());
+    for (row, run) in rows.iter().zip(&runs) {
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(cells.len(), 11, "{row}");
+        let dir = sweep.join(run["dir"].as_str().expect("dir"));
+        let summary = json(&dir.join("summary.json"));
+        let number = |s: &str| s.parse::<f64>().expect("number");
+        assert_eq!(cells[0], run["preset"].as_str().expect("preset"));
+        assert_eq!(cells[1], run["variant"].as_str().expect("variant"));
+        let algo = if cells[1] == "zv" {
+            "sepg-zv"
+        } else {
+            "gpomdp-adam"
+        };
+        assert_eq!(cells[2], algo);
+        assert_eq!(number(cells[3]), run["sigma0"].as_f64().expect("sigma0"));
+        assert_eq!(cells[4], run["seed"].to_string());
+        assert_eq!(
+            number(cells[5]),
+            summary["final"]["v"][0].as_f64().expect("v")
+        );
+        assert_eq!(
+            number(cells[6]),
+            summary["final"]["sigma"][0].as_f64().expect("sigma")
+        );
+        assert_eq!(
+            number(cells[7]),
+            summary["last_j_explore"].as_f64().expect("j")
+        );
+        assert_eq!(
+            number(cells[8]),
+            summary["abs_v_error"].as_f64().expect("error")
+        );
+        assert_eq!(cells[9], summary["infeasible_iterations"].to_string());
+        let audit = sepg(&["audit", "--json", dir.to_str().expect("utf-8")]);
+        let report: serde_json::Value = serde_json::from_slice(&audit.stdout).expect("json");
+        assert_eq!(
+            cells[10],
+            report["status"].as_str().expect("status"),
+            "{row}"
+        );
+    }
 }

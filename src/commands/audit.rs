@@ -9,6 +9,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use sepg_runs::audit::{DEFAULT_ALPHA, Status, audit, render};
+use sepg_runs::sweep::{SUMMARY_CSV, SWEEP_FILE, SweepFile, write_summary_csv};
 
 use crate::cli::CliError;
 
@@ -28,7 +29,9 @@ Exit status:
   2  malformed or incomplete input: not a run folder, NaN or non-numeric cells, missing rows,
      missing summary.json, an unfinished run")]
 pub struct AuditArgs {
-    /// Run folder written by `sepg run` (complete, or interrupted: its checkpointed rows).
+    /// Run folder written by `sepg run` (complete, or interrupted: its checkpointed rows), or a
+    /// sweep folder: every run is audited at the default tolerance and level, and the audit
+    /// column of its summary.csv filled in.
     #[arg(value_name = "DIR")]
     dir: PathBuf,
     /// Print the report as JSON on standard output instead of the table.
@@ -49,6 +52,9 @@ pub struct AuditArgs {
 /// failure (exit 1) when a check is violated (the report is printed first) or J cannot be
 /// recomputed.
 pub fn run(args: &AuditArgs) -> Result<(), CliError> {
+    if args.dir.join(SWEEP_FILE).is_file() {
+        return sweep_audit(args);
+    }
     let report = audit(&args.dir, args.tolerance, args.alpha)?;
     if args.json {
         let text = serde_json::to_string_pretty(&report)
@@ -76,4 +82,50 @@ pub fn run(args: &AuditArgs) -> Result<(), CliError> {
         ))),
         _ => Ok(()),
     }
+}
+
+/// `sepg audit SWEEP_DIR`: audits every run of a sweep folder into its `summary.csv` and
+/// prints one line per status; exit 1 if a run is violated, 2 if one is malformed or
+/// incomplete.
+fn sweep_audit(args: &AuditArgs) -> Result<(), CliError> {
+    let file = SweepFile::read(&args.dir)?;
+    let statuses = write_summary_csv(&args.dir, &file, true)?;
+    let count = |s: &str| statuses.iter().filter(|x| x.as_str() == s).count();
+    if args.json {
+        let runs: Vec<serde_json::Value> = file
+            .shard_runs()
+            .zip(&statuses)
+            .map(|(r, s)| serde_json::json!({ "dir": r.dir, "status": s }))
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({ "dir": args.dir.display().to_string(), "runs": runs })
+        );
+    } else {
+        println!(
+            "{}: {} runs audited into {SUMMARY_CSV}: {} hold, {} violated, {} incomplete, {} malformed, {} could not be audited",
+            args.dir.display(),
+            statuses.len(),
+            count("holds"),
+            count("violated"),
+            count("incomplete"),
+            count("malformed"),
+            count("error")
+        );
+    }
+    if count("violated") > 0 {
+        return Err(CliError::failure(format!(
+            "{} run(s) of {} broke the safety requirement (see {SUMMARY_CSV})",
+            count("violated"),
+            args.dir.display()
+        )));
+    }
+    if count("holds") < statuses.len() {
+        return Err(CliError::usage(format!(
+            "{} run(s) of {} could not be certified (see {SUMMARY_CSV})",
+            statuses.len() - count("holds"),
+            args.dir.display()
+        )));
+    }
+    Ok(())
 }

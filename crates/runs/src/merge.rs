@@ -134,5 +134,6 @@ pub fn merge(shards: &[PathBuf], out: &Path, force: bool) -> Result<SweepFile> {
     let built = tmp.keep();
     fs::rename(&built, out)
         .map_err(|e| Error::failed(format!("cannot create {}: {e}", out.display())))?;
+    crate::sweep::write_summary_csv(out, &merged, false)?;
     Ok(merged)
 }

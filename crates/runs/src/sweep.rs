@@ -37,6 +37,8 @@ use crate::spec::{EnvName, Resolved, RunSpec, Values, toml_message};
 pub const SWEEP_FILE: &str = "sweep.json";
 /// Folder of the run folders inside a sweep folder.
 pub const RUNS_DIR: &str = "runs";
+/// One row per run of a finished sweep folder: its settings, outcome and audit status.
+pub const SUMMARY_CSV: &str = "summary.csv";
 
 /// Seeds of a sweep: a count (seeds 0..count) or an explicit list.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -412,6 +414,7 @@ pub fn execute(
             dir: dir.to_path_buf(),
         });
     }
+    write_summary_csv(dir, file, false)?;
     Ok(SweepStats {
         runs: todo.len(),
         iterations: total,
@@ -430,7 +433,7 @@ pub fn start(
     force: bool,
     opts: SweepOptions<'_>,
 ) -> Result<SweepStats> {
-    check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR])?;
+    check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR, SUMMARY_CSV])?;
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::failed(format!("cannot create {}: {e}", dir.display())))?;
     write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())?;
@@ -454,6 +457,83 @@ pub fn resume(dir: &Path, opts: SweepOptions<'_>) -> Result<(SweepFile, SweepSta
     }
     let stats = execute(dir, &file, &resolved, opts)?;
     Ok((file, stats))
+}
+
+/// The header of [`SUMMARY_CSV`].
+pub const SUMMARY_CSV_HEADER: &str =
+    "preset,variant,algorithm,sigma0,seed,v,sigma,j,abs_v_error,infeasible,audit";
+
+/// Writes [`SUMMARY_CSV`] in the sweep folder `dir`: one row per run of its shard, in sweep
+/// order, with the preset, variant, algorithm, σ⁰, seed, final v and σ (components joined by
+/// `;`), the last logged J of the exploratory policy, max_i |v_i − v*_i| (LQG), the number of
+/// infeasible iterations and, with `audit`, the status of `sepg audit` at its defaults
+/// (`holds`, `violated`, `incomplete`, or `malformed` / `error` when the audit could not run;
+/// without `audit`: `not-audited`, since recomputing exact J costs several times the run
+/// itself). Runs are audited in parallel; the file is replaced atomically. Returns the audit
+/// status of each run, in sweep order.
+///
+/// # Errors
+/// [`Error::Failed`] when a finished run's summary cannot be read or the file cannot be
+/// written.
+pub fn write_summary_csv(dir: &Path, file: &SweepFile, audit: bool) -> Result<Vec<String>> {
+    use crate::audit::{DEFAULT_ALPHA, Status, audit as run_audit};
+    use crate::folder::{load_resolved, read_summary};
+    let runs: Vec<&RunEntry> = file.shard_runs().collect();
+    let rows: Vec<Result<String>> = runs
+        .par_iter()
+        .map(|r| {
+            let run_dir = dir.join(&r.dir);
+            let summary = read_summary(&run_dir)?;
+            let algorithm = load_resolved(&run_dir)?.spec.algo.map_or("", |a| a.name());
+            let status = if audit {
+                match run_audit(&run_dir, 1e-9, DEFAULT_ALPHA) {
+                    Ok(a) => match a.status {
+                        Status::Holds => "holds",
+                        Status::Violated => "violated",
+                        _ => "incomplete",
+                    },
+                    Err(e) if e.is_invalid_input() => "malformed",
+                    Err(_) => "error",
+                }
+            } else {
+                "not-audited"
+            };
+            let join = |xs: &[f64]| {
+                xs.iter()
+                    .map(|x| format!("{x:?}"))
+                    .collect::<Vec<_>>()
+                    .join(";")
+            };
+            let opt = |x: Option<f64>| x.map(|x| format!("{x:?}")).unwrap_or_default();
+            Ok(format!(
+                "{},{},{algorithm},{:?},{},{},{},{},{},{},{status}\n",
+                r.preset.name(),
+                r.variant,
+                r.sigma0,
+                r.seed,
+                join(&summary.final_params.v),
+                join(&summary.final_params.sigma),
+                opt(summary.last_j_explore),
+                opt(summary.abs_v_error),
+                summary.infeasible_iterations,
+            ))
+        })
+        .collect();
+    let mut text = format!("{SUMMARY_CSV_HEADER}\n");
+    let mut statuses = Vec::new();
+    for row in rows {
+        let row = row?;
+        statuses.push(
+            row.trim_end()
+                .rsplit(',')
+                .next()
+                .unwrap_or_default()
+                .to_owned(),
+        );
+        text.push_str(&row);
+    }
+    write_atomic(&dir.join(SUMMARY_CSV), text.as_bytes())?;
+    Ok(statuses)
 }
 
 #[cfg(test)]
