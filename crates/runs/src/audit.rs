@@ -253,7 +253,9 @@ const INTEGER_COLUMNS: [&str; 8] = [
 ];
 
 /// Columns that are empty when they do not apply to the algorithm or the iteration.
-const OPTIONAL_COLUMNS: [&str; 7] = [
+const OPTIONAL_COLUMNS: [&str; 9] = [
+    "certified_v",
+    "certified_w",
     "j_after_v",
     "required",
     "required_w",
