@@ -6,6 +6,7 @@
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
+use sepg_algo::core::options::WStep;
 use sepg_algo::solver::sampled::BlockEstimator;
 use sepg_algo::solver::source::{Grad, Need};
 use sepg_algo::solver::steps::{self, Plan};
@@ -183,7 +184,9 @@ fn v_step(
 /// standard deviations σ_j = e^{w_j}; the widths are per component or a scalar.
 #[pyfunction]
 /// With `certify=True` the step is chosen with the certified (interval-arithmetic) bounds.
-#[pyo3(signature = (constants, sigmas, grad_w_j, grad_w_l = None, eps_j = None, eps_l = None, required = 0.0, certify = false))]
+/// Estimated gradients along ∇_w L use the exploring w-update (the confidence of ∇̂_w J only)
+/// unless `theorem_4_9=True` asks for Theorem 4.9's form (eq. 4.30).
+#[pyo3(signature = (constants, sigmas, grad_w_j, grad_w_l = None, eps_j = None, eps_l = None, required = 0.0, certify = false, theorem_4_9 = false))]
 #[allow(clippy::too_many_arguments)]
 fn w_step(
     constants: PyRef<'_, PyTaskConstants>,
@@ -194,7 +197,13 @@ fn w_step(
     eps_l: Option<&Bound<'_, PyAny>>,
     required: f64,
     certify: bool,
+    theorem_4_9: bool,
 ) -> PyResult<PySafeStep> {
+    let form = if theorem_4_9 {
+        WStep::Theorem49
+    } else {
+        WStep::Exploring
+    };
     let sigmas = vector(sigmas, "sigmas")?;
     let gj = grad(grad_w_j, eps_j, "grad_w_j")?;
     if gj.value.len() != sigmas.len() {
@@ -214,7 +223,7 @@ fn w_step(
                     sigmas.len()
                 )));
             }
-            steps::w_step_surrogate(&constants.0, &sigmas, &gl, &gj, required, certify)
+            steps::w_step_surrogate(&constants.0, &sigmas, &gl, &gj, required, certify, form)
         }
         None if eps_l.is_some() => return Err(invalid("eps_l was given without grad_w_l")),
         None => steps::w_step_naive(&constants.0, &sigmas, &gj, required, certify),
@@ -375,6 +384,7 @@ fn estimate_block<'py>(
         grad_v: true,
         grad_wj: true,
         grad_wl: grad_w_l,
+        j_width: false,
     };
     let e = BlockEstimator::new(delta, GradientSpec::default(), k)
         .estimate(&batch, need)

@@ -153,6 +153,8 @@ impl PyCollector {
                 Block::V => "v",
                 Block::Target => "target",
                 Block::W => "w",
+                Block::Reference => "reference",
+                Block::ReferenceTarget => "reference-target",
             },
             n: r.n,
             scores: r.scores,

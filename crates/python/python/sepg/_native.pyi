@@ -177,6 +177,7 @@ def w_step(
     eps_l: Optional[ArrayLike] = None,
     required: float = 0.0,
     certify: bool = False,
+    theorem_4_9: bool = False,
 ) -> SafeStep: ...
 def ada_step(
     constants: TaskConstants, sigma: float, grad: ArrayLike, eps: Optional[ArrayLike] = None
