@@ -114,9 +114,10 @@ fn the_issue_form_writes_a_complete_run_folder() {
     for (i, row) in rows.iter().enumerate() {
         assert_eq!(row.len(), header.len());
         assert_eq!(at(row, "iteration"), i.to_string());
-        // N = 100 trajectories per iteration, each exactly H = 20 steps (LQG never terminates).
-        assert_eq!(at(row, "trajectories"), (100 * (i + 1)).to_string());
-        assert_eq!(at(row, "steps"), (2000 * (i + 1)).to_string());
+        // N = 100 trajectories per iteration, each exactly H = 20 steps (LQG never terminates),
+        // after ZV's two reference batches of 1000 trajectories (J(θ⁰) and the first target).
+        assert_eq!(at(row, "trajectories"), (2000 + 100 * (i + 1)).to_string());
+        assert_eq!(at(row, "steps"), (40_000 + 2000 * (i + 1)).to_string());
         assert_eq!(at(row, "w_target"), "-inf", "ZV's target is deterministic");
     }
     assert_eq!(at(&rows[0], "v"), "-0.1");

@@ -25,7 +25,7 @@
 //! | [`rigorous_safe_step_along_j`], [`rigorous_safe_step_along_l`] | rigorous w-bound | [`crate::rigorous`] |
 
 use crate::constants::TaskConstants;
-use crate::error::{BoundsError, finite, finite_vector, inf_norm, positive};
+use crate::error::{BoundsError, finite, finite_vector, inf_norm, non_negative, positive};
 use crate::high_probability::{self as hp, HpForm};
 use crate::interval::{Interval, from_ordered_key, ordered_key};
 use crate::outcome::{SafeInterval, StepOutcome};
@@ -923,5 +923,92 @@ pub fn rigorous_safe_step_along_l(
 ) -> Result<Certified, BoundsError> {
     let outcome = rigorous::safe_step_along_l(k, sigma, grad_w_j, grad_w_l, required)?;
     let enclosure = RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_l)?;
+    Ok(certify(&enclosure, outcome, required))
+}
+
+/// The bound of the exploring w-update (`crate::exploring`) as a function of the step size β
+/// along ∇̂_w L (Δw = β·∇̂_w L), with an enclosed d(σ).
+///
+/// # Formula
+///
+/// ```text
+/// B(β) = Δw·∇̂_w J − |Δw|·ε_J − d(σ)·Δw²,   Δw = β·∇̂_w L
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExploringEnclosure {
+    /// ∇̂_w J.
+    pub grad_w_j_hat: f64,
+    /// ε_J ≥ 0.
+    pub eps_j: f64,
+    /// ∇̂_w L, the direction.
+    pub grad_w_l_hat: f64,
+    /// Enclosure of d(σ).
+    pub d: Interval,
+}
+
+impl ExploringEnclosure {
+    /// The enclosure for the task `k` at standard deviation `sigma`.
+    ///
+    /// # Errors
+    /// Non-finite estimates, ε_J < 0, and the errors of [`d`].
+    pub fn new(
+        k: &TaskConstants,
+        sigma: f64,
+        grad_w_j_hat: f64,
+        eps_j: f64,
+        grad_w_l_hat: f64,
+    ) -> Result<Self, BoundsError> {
+        let eps_j = non_negative("eps_j", eps_j)?;
+        Ok(ExploringEnclosure {
+            grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
+            eps_j,
+            grad_w_l_hat: finite("grad_w_l_hat", grad_w_l_hat)?,
+            d: d(k, sigma)?,
+        })
+    }
+}
+
+impl EnclosedBound for ExploringEnclosure {
+    fn enclose(&self, x: f64) -> Interval {
+        let dw = Interval::point(x).scale(self.grad_w_l_hat);
+        let abs = if dw.lo() >= 0.0 {
+            dw
+        } else if dw.hi() <= 0.0 {
+            -dw
+        } else {
+            Interval::new(0.0, dw.hi().max(-dw.lo())).unwrap_or(dw)
+        };
+        dw.scale(self.grad_w_j_hat) - abs.scale(self.eps_j) - self.d * dw.sqr()
+    }
+
+    fn slope(&self, x: f64) -> Option<f64> {
+        let l = self.grad_w_l_hat;
+        let dw = x * l;
+        Some(l * (self.grad_w_j_hat - dw.signum() * self.eps_j - 2.0 * self.d.lo() * dw))
+    }
+}
+
+/// Certified exploring w-step along ∇̂_w L (`crate::exploring::w_exploring_step`) for the
+/// requirement C: the returned β's enclosed bound has lower end ≥ C.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::exploring_safe_step(&k, 1.0, -0.3, 0.1, 0.4, -0.01)?;
+/// assert!(o.is_certified() && o.bound().unwrap().lo() >= -0.01);
+/// assert!(o.chosen_step().unwrap() > 0.0);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn exploring_safe_step(
+    k: &TaskConstants,
+    sigma: f64,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    let outcome =
+        crate::exploring::w_exploring_step(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, required)?;
+    let enclosure = ExploringEnclosure::new(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat)?;
     Ok(certify(&enclosure, outcome, required))
 }

@@ -158,8 +158,11 @@ pub fn w_step_surrogate(
     let h = argmax_abs(&gl.value).map_err(be)?;
     let (s, l, j) = (sigmas[h], gl.value[h], gj.value[h]);
     let exact = is_exact(gl) && is_exact(gj);
+    if form == WStep::Exploring && !exact && certify {
+        let outcome = certified::exploring_safe_step(k, s, j, gj.eps[h], l, required);
+        return Ok(plan_certified(outcome.map_err(be)?, h, l));
+    }
     if form == WStep::Exploring && !exact {
-        // The exploring w-update (not yet certified in interval arithmetic).
         let ej = gj.eps[h];
         let bound = ExploringBound::new(k, s, j, ej).map_err(be)?;
         let outcome = w_exploring_step(k, s, j, ej, l, required).map_err(be)?;

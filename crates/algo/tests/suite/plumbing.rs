@@ -9,6 +9,7 @@
 //! Cost: about 0.5 s.
 use approx::{abs_diff_eq, assert_relative_eq, assert_ulps_eq};
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
+use sepg_algo::core::options::{SepgOptions, WStep};
 use sepg_algo::core::record::Record;
 use sepg_algo::core::seed::Block;
 use sepg_bounds::constants::{TaskConstants, c, dc_dsigma};
@@ -99,6 +100,17 @@ fn assert_guarantee(logged: Option<f64>, bound: Option<HighProbabilityBound>, st
     }
 }
 
+/// The w-step of Theorem 4.9 (sign-aware) and J(θ⁰) from the first v-block, with no
+/// reference batch: the plumbing these tests recompute by hand (the exploring w-step and the
+/// reference batch have their own tests in `sepg-bounds` and `options.rs`).
+fn thesis_form() -> SepgOptions {
+    SepgOptions {
+        w_step: WStep::Theorem49,
+        reference_batch: 0,
+        ..SepgOptions::default()
+    }
+}
+
 /// The first sampled iteration of LB-II (B⁰ = 0.05, two blocks of 50 trajectories, δ = 0.2)
 /// and of its naive-w variant, for several seeds, with certified and with f64 steps,
 /// recomputed from the batches.
@@ -123,6 +135,7 @@ fn one_sampled_iteration_recomputed_from_its_batches() {
             sigma0: vec![0.5],
             seed,
             initial_budget: b0,
+            options: thesis_form(),
             ..SepgConfig::new(AnyEnv::Lqg(Box::new(env.clone())), alg)
         };
         let checked = cfg.clone().check().expect("valid");
@@ -260,6 +273,7 @@ fn logged_requirements_follow_from_the_logged_j() {
             sigma0: vec![0.5],
             seed: 9,
             initial_budget: b0,
+            options: thesis_form(),
             ..SepgConfig::new(
                 AnyEnv::Lqg(Box::new(LqgEnv::thesis())),
                 Algorithm::Sepg(req),
