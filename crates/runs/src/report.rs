@@ -297,7 +297,7 @@ fn grid_columns(n: usize) -> usize {
 }
 
 /// The budget panel `p` with its B = 0 line: the safety requirement of the budget-based
-/// variants is Bᵗ ≥ 0 (Sec 4.2).
+/// variants is Bᵗ ≥ 0 (Definition 4.3, Sec 4.2.2).
 fn with_zero_line(mut p: Panel) -> Panel {
     p.hlines.push(("B = 0".into(), 0.0));
     p
