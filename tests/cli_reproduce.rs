@@ -116,9 +116,18 @@ fn figures_and_plots_are_png_and_svg() {
     let png = std::fs::read(dir.join("fig-5.1-lqg.png")).expect("png");
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let svg = std::fs::read_to_string(dir.join("fig-5.1-lqg.svg")).expect("svg");
-    assert!(svg.contains("<svg") && svg.contains("fig-5.1") && svg.contains("lb1"));
-    // A sweep folder and a run folder both plot.
-    ok(&["plot", d, "--quiet"]);
+    assert!(svg.contains("<svg") && svg.contains("fig-5.1") && svg.contains("SEPG-LB-I"));
+    // A sweep folder and a run folder both plot; two seeds draw a band with a warning,
+    // which `--band none` silences.
+    let two = sepg(&["plot", d, "--quiet"]);
+    assert!(two.status.success());
+    let warned = String::from_utf8_lossy(&two.stderr);
+    assert!(
+        warned.contains("warning") && warned.contains("2 seed"),
+        "{warned}"
+    );
+    let none = sepg(&["plot", d, "--quiet", "--band", "none"]);
+    assert!(none.status.success() && none.stderr.is_empty());
     assert!(dir.join("plot.png").is_file() && dir.join("plot.svg").is_file());
     let run = dir.join("runs/lqg/mi/sigma-1.0/seed-0");
     let file = tmp.path().join("one.svg");

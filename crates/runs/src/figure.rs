@@ -31,6 +31,67 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
+/// Colour of series `i` out of `n`: the Tableau 10 palette up to ten series; beyond, `n` hues
+/// spread evenly around the colour wheel, neighbours in hue also differing in lightness, so
+/// that no two series of a figure share a colour however many there are.
+pub fn colour(i: usize, n: usize) -> RGBColor {
+    if n <= PALETTE.len() {
+        return PALETTE[i % PALETTE.len()];
+    }
+    let hue = i as f64 / n as f64;
+    let lightness = [0.42, 0.62, 0.30][i % 3];
+    hsl_to_rgb(hue, 0.80, lightness)
+}
+
+/// sRGB colour of hue `h` ∈ [0, 1) (fraction of a turn), saturation `s` and lightness `l`
+/// ∈ [0, 1] (the HSL model).
+fn hsl_to_rgb(h: f64, s: f64, l: f64) -> RGBColor {
+    let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
+    let hp = 6.0 * h.rem_euclid(1.0);
+    let x = c * (1.0 - (hp % 2.0 - 1.0).abs());
+    let (r, g, b) = match hp as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = l - c / 2.0;
+    let byte = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
+    RGBColor(byte(r), byte(g), byte(b))
+}
+
+/// What the band around a mean curve shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[non_exhaustive]
+pub enum BandKind {
+    /// Two-sided 95% t-interval of the mean: m ± t(0.975, K − 1)·s/√K (wide for few seeds:
+    /// t(0.975, 1) = 12.7).
+    #[default]
+    Ci95,
+    /// One standard error: m ± s/√K.
+    Se,
+    /// No band.
+    None,
+}
+
+impl BandKind {
+    /// How the band is described in a figure's title.
+    pub fn describe(self) -> &'static str {
+        match self {
+            BandKind::Ci95 => "mean and 95% t-interval across seeds",
+            BandKind::Se => "mean ± one standard error across seeds",
+            BandKind::None => "mean across seeds",
+        }
+    }
+}
+
+/// Fewest seeds for which a band is worth drawing without a warning: with two seeds the 95%
+/// t-interval uses t(0.975, 1) = 12.7 and the standard error rests on one degree of freedom.
+pub const MIN_BAND_SEEDS: usize = 3;
+
 /// Lower and upper ends of a confidence band, point by point.
 pub type Band = (Vec<f64>, Vec<f64>);
 
@@ -62,6 +123,23 @@ pub struct Panel {
     pub hlines: Vec<(String, f64)>,
 }
 
+impl Panel {
+    /// The panel with every band raised to at least `floor`, for quantities that cannot go
+    /// below it (σ ≥ 0): a symmetric band around a mean close to the floor would otherwise
+    /// show impossible values.
+    #[must_use]
+    pub fn clipped_at(mut self, floor: f64) -> Panel {
+        for s in &mut self.series {
+            if let Some((lo, hi)) = &mut s.band {
+                for y in lo.iter_mut().chain(hi.iter_mut()) {
+                    *y = y.max(floor);
+                }
+            }
+        }
+        self
+    }
+}
+
 /// A figure: a title and a grid of panels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
@@ -73,13 +151,15 @@ pub struct Figure {
     pub columns: usize,
 }
 
-/// Mean and 95% confidence band across seeds of equally long curves, point by point.
+/// Mean and band of kind `kind` across seeds of equally long curves, point by point (the
+/// curves are cut to the shortest).
 ///
 /// # Formula
 /// ```text
-/// m = mean(y),  s = sample sd(y),  band = m ± t(0.975, K − 1) · s / √K     (K ≥ 2 seeds)
+/// m = mean(y),  s = sample sd(y),  K seeds (band only for K ≥ 2)
+/// Ci95: m ± t(0.975, K − 1) · s / √K        Se: m ± s / √K        None: no band
 /// ```
-pub fn mean_band(curves: &[Vec<f64>]) -> (Vec<f64>, Option<Band>) {
+pub fn mean_band(curves: &[Vec<f64>], kind: BandKind) -> (Vec<f64>, Option<Band>) {
     let len = curves.iter().map(Vec::len).min().unwrap_or(0);
     let k = curves.len();
     let mut mean = Vec::with_capacity(len);
@@ -87,18 +167,20 @@ pub fn mean_band(curves: &[Vec<f64>]) -> (Vec<f64>, Option<Band>) {
     let mut hi = Vec::with_capacity(len);
     for i in 0..len {
         let ys: Vec<f64> = curves.iter().map(|c| c[i]).collect();
-        let (m, h) = mean_halfwidth(&ys);
+        let (m, h) = match kind {
+            BandKind::Se => mean_se(&ys),
+            _ => mean_halfwidth(&ys),
+        };
         mean.push(m);
         lo.push(m - h.unwrap_or(0.0));
         hi.push(m + h.unwrap_or(0.0));
     }
-    let band = (k >= 2).then_some((lo, hi));
+    let band = (k >= 2 && kind != BandKind::None).then_some((lo, hi));
     (mean, band)
 }
 
-/// Mean of `ys` and the half-width t(0.975, K − 1)·s/√K of its two-sided 95% confidence
-/// interval (`None` for fewer than two values).
-pub fn mean_halfwidth(ys: &[f64]) -> (f64, Option<f64>) {
+/// Mean of `ys` and its standard error s/√K (`None` for fewer than two values).
+fn mean_se(ys: &[f64]) -> (f64, Option<f64>) {
     let k = ys.len();
     if k == 0 {
         return (f64::NAN, None);
@@ -108,8 +190,19 @@ pub fn mean_halfwidth(ys: &[f64]) -> (f64, Option<f64>) {
         return (m, None);
     }
     let var = ys.iter().map(|y| (y - m) * (y - m)).sum::<f64>() / (k - 1) as f64;
+    (m, Some((var / k as f64).sqrt()))
+}
+
+/// Mean of `ys` and the half-width t(0.975, K − 1)·s/√K of its two-sided 95% confidence
+/// interval (`None` for fewer than two values).
+pub fn mean_halfwidth(ys: &[f64]) -> (f64, Option<f64>) {
+    let k = ys.len();
+    if k == 0 {
+        return (f64::NAN, None);
+    }
+    let (m, se) = mean_se(ys);
     let t = student_t_quantile(0.975, (k - 1) as f64).unwrap_or(f64::NAN);
-    (m, Some(t * (var / k as f64).sqrt()))
+    (m, se.map(|se| t * se))
 }
 
 fn register_font() -> Result<()> {
@@ -181,16 +274,183 @@ fn tick(v: &f64) -> String {
     }
 }
 
+/// Most points drawn per curve: longer curves are reduced to this many buckets, each keeping
+/// its lowest and highest point, so that spikes survive and a sweep's SVG stays small.
+const MAX_BUCKETS: usize = 300;
+
+/// The finite points of `(x, y)` reduced to at most [`MAX_BUCKETS`] buckets of consecutive
+/// points, each kept as its lowest and highest point in order (`Pick::Both`), or only the
+/// lowest (`Pick::Min`, lower band edges) or highest (`Pick::Max`, upper band edges), so the
+/// drawn envelope never shrinks.
+fn decimate(x: &[f64], y: &[f64], pick: Pick) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = finite_points(x.iter().zip(y)).collect();
+    if pts.len() <= 2 * MAX_BUCKETS {
+        return pts;
+    }
+    let stride = pts.len().div_ceil(MAX_BUCKETS);
+    let mut out = Vec::with_capacity(2 * MAX_BUCKETS + 1);
+    for chunk in pts.chunks(stride) {
+        let by_y = |a: &&(f64, f64), b: &&(f64, f64)| a.1.total_cmp(&b.1);
+        let lo = chunk.iter().min_by(by_y).copied();
+        let hi = chunk.iter().max_by(by_y).copied();
+        match (pick, lo, hi) {
+            (Pick::Min, Some(lo), _) => out.push(lo),
+            (Pick::Max, _, Some(hi)) => out.push(hi),
+            (Pick::Both, Some(lo), Some(hi)) => {
+                if lo.0 <= hi.0 {
+                    out.extend([lo, hi]);
+                } else {
+                    out.extend([hi, lo]);
+                }
+            }
+            _ => {}
+        }
+    }
+    out.dedup();
+    out
+}
+
+/// Which points of a bucket [`decimate`] keeps.
+#[derive(Clone, Copy)]
+enum Pick {
+    Min,
+    Max,
+    Both,
+}
+
+/// Pixel geometry of a drawn figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Layout {
+    /// Width and height of the whole image.
+    width: u32,
+    height: u32,
+    /// Panel grid (rows, columns).
+    rows: u32,
+    columns: u32,
+    /// Left edge of the legend column, right of every panel.
+    legend_x: u32,
+}
+
+const PANEL_W: u32 = 520;
+const PANEL_H: u32 = 400;
+const TITLE_H: u32 = 60;
+const LEGEND_ROW: u32 = 20;
+
+/// One entry of the legend: a label, its colour and whether it is a dashed reference line.
+struct Entry {
+    label: String,
+    colour: RGBColor,
+    dashed: bool,
+}
+
+/// The panels that have something to show.
+fn shown(fig: &Figure) -> Vec<&Panel> {
+    fig.panels
+        .iter()
+        .filter(|p| {
+            p.series
+                .iter()
+                .any(|s| s.mean.iter().any(|y| y.is_finite()))
+        })
+        .collect()
+}
+
+/// The legend entries of `fig`: every series label once, in order of first appearance, then
+/// every reference line once. A label keeps its colour in every panel.
+fn legend(fig: &Figure) -> Vec<Entry> {
+    let mut labels: Vec<&str> = Vec::new();
+    for s in fig.panels.iter().flat_map(|p| &p.series) {
+        if !labels.contains(&s.label.as_str()) {
+            labels.push(&s.label);
+        }
+    }
+    let n = labels.len();
+    let mut out: Vec<Entry> = labels
+        .iter()
+        .enumerate()
+        .map(|(i, l)| Entry {
+            label: (*l).to_owned(),
+            colour: colour(i, n),
+            dashed: false,
+        })
+        .collect();
+    for (l, _) in fig.panels.iter().flat_map(|p| &p.hlines) {
+        if !out.iter().any(|e| e.dashed && e.label == *l) {
+            out.push(Entry {
+                label: l.clone(),
+                colour: BLACK,
+                dashed: true,
+            });
+        }
+    }
+    out
+}
+
+fn layout(fig: &Figure) -> Layout {
+    let n = shown(fig).len().max(1) as u32;
+    let columns = (fig.columns.max(1) as u32).min(n);
+    let rows = n.div_ceil(columns);
+    let entries = legend(fig);
+    let chars = entries
+        .iter()
+        .map(|e| e.label.chars().count())
+        .max()
+        .unwrap_or(0) as u32;
+    let legend_w = 50 + 7 * chars.max(8);
+    let legend_h = TITLE_H + 20 + LEGEND_ROW * entries.len() as u32;
+    Layout {
+        width: PANEL_W * columns + legend_w,
+        height: (TITLE_H + PANEL_H * rows).max(legend_h),
+        rows,
+        columns,
+        legend_x: PANEL_W * columns,
+    }
+}
+
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let lay = layout(fig);
     root.fill(&WHITE).map_err(e)?;
     let area = root.titled(&fig.title, (FAMILY, 22)).map_err(e)?;
-    let cols = fig.columns.max(1);
-    let rows = fig.panels.len().div_ceil(cols).max(1);
-    for (cell, panel) in area.split_evenly((rows, cols)).iter().zip(&fig.panels) {
-        draw_panel(cell, panel)?;
+    let (panels_area, legend_area) = area.split_horizontally(lay.legend_x);
+    let panels_area = panels_area.shrink((0, 0), (lay.legend_x, PANEL_H * lay.rows));
+    let entries = legend(fig);
+    let cells = panels_area.split_evenly((lay.rows as usize, lay.columns as usize));
+    for (cell, panel) in cells.iter().zip(shown(fig)) {
+        draw_panel(cell, panel, &entries)?;
     }
+    draw_legend(&legend_area, &entries)?;
     root.present().map_err(e)
+}
+
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[Entry],
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let font = (FAMILY, 13).into_font().color(&BLACK);
+    for (i, entry) in entries.iter().enumerate() {
+        let y = 30 + LEGEND_ROW as i32 * i as i32;
+        let line = vec![(10, y), (38, y)];
+        if entry.dashed {
+            area.draw(&PathElement::new(
+                vec![(10, y), (20, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(e)?;
+            area.draw(&PathElement::new(
+                vec![(28, y), (38, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(e)?;
+        } else {
+            area.draw(&PathElement::new(line, entry.colour.stroke_width(3)))
+                .map_err(e)?;
+        }
+        area.draw(&Text::new(entry.label.as_str(), (46, y - 7), font.clone()))
+            .map_err(e)?;
+    }
+    Ok(())
 }
 
 /// The (x, y) points of a curve where both are finite.
@@ -205,6 +465,7 @@ fn finite_points<'a>(
 fn draw_panel<DB: DrawingBackend>(
     cell: &DrawingArea<DB, Shift>,
     panel: &Panel,
+    entries: &[Entry],
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let (x0, x1, y0, y1) = range(panel);
@@ -228,28 +489,29 @@ fn draw_panel<DB: DrawingBackend>(
         .light_line_style(WHITE)
         .draw()
         .map_err(e)?;
-    for (i, s) in panel.series.iter().enumerate() {
-        let color = PALETTE[i % PALETTE.len()];
+    for s in &panel.series {
+        let colour = entries
+            .iter()
+            .find(|en| !en.dashed && en.label == s.label)
+            .map_or(BLACK, |en| en.colour);
         if let Some((lo, hi)) = &s.band {
-            let mut poly: Vec<(f64, f64)> = finite_points(s.x.iter().zip(hi)).collect();
-            poly.extend(finite_points(s.x.iter().zip(lo).rev()));
+            let mut poly = decimate(&s.x, hi, Pick::Max);
+            poly.extend(decimate(&s.x, lo, Pick::Min).into_iter().rev());
             chart
                 .draw_series(std::iter::once(Polygon::new(
                     poly,
-                    color.mix(0.18).filled(),
+                    colour.mix(0.18).filled(),
                 )))
                 .map_err(e)?;
         }
-        let pts: Vec<(f64, f64)> = finite_points(s.x.iter().zip(&s.mean)).collect();
         chart
-            .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-            .map_err(e)?
-            .label(s.label.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            .draw_series(LineSeries::new(
+                decimate(&s.x, &s.mean, Pick::Both),
+                colour.stroke_width(2),
+            ))
+            .map_err(e)?;
     }
-    for (label, y) in &panel.hlines {
+    for (_, y) in &panel.hlines {
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(x0, *y), (x1, *y)],
@@ -257,27 +519,14 @@ fn draw_panel<DB: DrawingBackend>(
                 4,
                 BLACK.stroke_width(1),
             ))
-            .map_err(e)?
-            .label(label.as_str())
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1)));
-    }
-    if !panel.series.is_empty() || !panel.hlines.is_empty() {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font((FAMILY, 11))
-            .draw()
             .map_err(e)?;
     }
     Ok(())
 }
 
 fn size(fig: &Figure) -> (u32, u32) {
-    let cols = fig.columns.max(1) as u32;
-    let rows = fig.panels.len().div_ceil(fig.columns.max(1)).max(1) as u32;
-    (520 * cols, 60 + 400 * rows)
+    let lay = layout(fig);
+    (lay.width, lay.height)
 }
 
 /// Writes `fig` to `path`, as PNG or SVG by the extension, atomically (rendered to a
@@ -349,5 +598,162 @@ mod tests {
         let t = 0.95 / (2.0 * 0.975 * 0.025f64).sqrt();
         assert!((h - t / 3f64.sqrt()).abs() < 1e-12, "{h}");
         assert_eq!(mean_halfwidth(&[5.0]), (5.0, None));
+    }
+
+    #[test]
+    fn standard_error_band_and_no_band() {
+        // Values 1, 2, 3 at every point: s = 1, K = 3, so the standard error is 1/√3.
+        let curves = vec![vec![1.0; 4], vec![2.0; 4], vec![3.0; 4]];
+        let (m, band) = mean_band(&curves, BandKind::Se);
+        assert_eq!(m, vec![2.0; 4]);
+        let (lo, hi) = band.expect("three seeds");
+        let se = 1.0 / 3f64.sqrt();
+        assert!(lo.iter().all(|y| (y - (2.0 - se)).abs() < 1e-12), "{lo:?}");
+        assert!(hi.iter().all(|y| (y - (2.0 + se)).abs() < 1e-12), "{hi:?}");
+        assert_eq!(mean_band(&curves, BandKind::None).1, None);
+    }
+
+    #[test]
+    fn sigma_bands_are_clipped_at_zero() {
+        // Two seeds with σ = 0.001 and 0.021: the 95% t-interval, 0.011 ± 12.7 · 0.01, reaches
+        // −0.116; clipped at 0 its lower end is 0 and its upper end is unchanged.
+        let curves = vec![vec![0.001, 0.5], vec![0.021, 0.5]];
+        let (mean, band) = mean_band(&curves, BandKind::Ci95);
+        let (lo, hi) = band.clone().expect("two seeds");
+        assert!(lo[0] < -0.1, "{lo:?}");
+        let panel = Panel {
+            series: vec![Series {
+                label: "σ".into(),
+                x: vec![0.0, 1.0],
+                mean,
+                band,
+            }],
+            ..Panel::default()
+        }
+        .clipped_at(0.0);
+        let (clo, chi) = panel.series[0].band.clone().expect("band kept");
+        assert_eq!(clo, vec![0.0, 0.5]);
+        assert_eq!(chi, hi);
+    }
+
+    /// CIE L*a*b* of an sRGB colour (D65 white), for perceptual distances.
+    fn lab(c: RGBColor) -> [f64; 3] {
+        let lin = |u: u8| {
+            let v = f64::from(u) / 255.0;
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let (r, g, b) = (lin(c.0), lin(c.1), lin(c.2));
+        let x = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047;
+        let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        let z = (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883;
+        let f = |t: f64| {
+            if t > 216.0 / 24389.0 {
+                t.cbrt()
+            } else {
+                (24389.0 / 27.0 * t + 16.0) / 116.0
+            }
+        };
+        let (fx, fy, fz) = (f(x), f(y), f(z));
+        [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+    }
+
+    #[test]
+    fn colours_stay_distinct_for_many_series() {
+        // Every pair of the n colours differs by a CIE76 ΔE of at least 10 for up to 24 series
+        // (about four just-noticeable differences), and no two colours coincide up to 100.
+        for n in 1..=100usize {
+            let cs: Vec<[f64; 3]> = (0..n).map(|i| lab(colour(i, n))).collect();
+            let mut min = f64::INFINITY;
+            for i in 0..n {
+                for j in 0..i {
+                    let d = (0..3).map(|k| (cs[i][k] - cs[j][k]).powi(2)).sum::<f64>();
+                    min = min.min(d.sqrt());
+                }
+            }
+            let need = if n <= 24 { 10.0 } else { 1.0 };
+            assert!(min >= need, "{n} series: closest pair ΔE = {min}");
+        }
+    }
+
+    #[test]
+    fn decimation_keeps_spikes_and_bounds_the_points() {
+        let x: Vec<f64> = (0..10_001).map(f64::from).collect();
+        let mut y = vec![0.0; x.len()];
+        y[4321] = 7.0;
+        let pts = decimate(&x, &y, Pick::Both);
+        assert!(pts.len() <= 2 * MAX_BUCKETS, "{}", pts.len());
+        assert!(pts.contains(&(4321.0, 7.0)));
+        assert!(decimate(&x, &y, Pick::Max).contains(&(4321.0, 7.0)));
+        assert!(!decimate(&x, &y, Pick::Min).contains(&(4321.0, 7.0)));
+    }
+
+    /// A sweep-sized figure: `groups` series of `len` points with bands in four panels.
+    fn big_figure(groups: usize, len: usize) -> Figure {
+        let x: Vec<f64> = (0..len).map(|i| i as f64).collect();
+        let series: Vec<Series> = (0..groups)
+            .map(|g| {
+                let mean: Vec<f64> = x.iter().map(|t| (t * 0.01 + g as f64).sin()).collect();
+                let lo = mean.iter().map(|m| m - 0.1).collect();
+                let hi = mean.iter().map(|m| m + 0.1).collect();
+                Series {
+                    label: format!("group {g}"),
+                    x: x.clone(),
+                    mean,
+                    band: Some((lo, hi)),
+                }
+            })
+            .collect();
+        let panel = Panel {
+            title: "p".into(),
+            series,
+            ..Panel::default()
+        };
+        Figure {
+            title: "sweep".into(),
+            panels: vec![panel; 4],
+            columns: 2,
+        }
+    }
+
+    #[test]
+    fn sweep_svg_is_small_and_its_legend_is_right_of_the_panels() {
+        // 16 groups × 4 panels × 10,001 iterations with bands: drawn in full this is
+        // over 15 MB of SVG.
+        let fig = big_figure(16, 10_001);
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.svg");
+        save(&fig, &path).expect("drawn");
+        let svg = std::fs::read_to_string(&path).expect("read");
+        assert!(svg.len() < 1_000_000, "{} bytes", svg.len());
+        let lay = layout(&fig);
+        assert_eq!((lay.rows, lay.columns, lay.legend_x), (2, 2, 2 * PANEL_W));
+        // Every legend label is a text element whose x lies right of the last panel column.
+        for g in 0..16 {
+            let label = format!(">\ngroup {g}\n</text>");
+            let at = svg
+                .find(&label)
+                .unwrap_or_else(|| panic!("group {g} not in legend"));
+            let open = svg[..at].rfind("<text x=\"").expect("text element") + 9;
+            let x: u32 = svg[open..]
+                .split('"')
+                .next()
+                .and_then(|v| v.parse().ok())
+                .expect("x attribute");
+            assert!(x >= lay.legend_x, "group {g} at x = {x}");
+        }
+    }
+
+    #[test]
+    fn empty_panels_are_not_drawn() {
+        let mut fig = big_figure(1, 10);
+        fig.panels[1].series.clear();
+        fig.columns = 3;
+        assert_eq!(shown(&fig).len(), 3);
+        let lay = layout(&fig);
+        assert_eq!((lay.rows, lay.columns), (1, 3));
     }
 }

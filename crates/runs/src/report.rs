@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::figure::{self, Figure, Panel, Series, mean_band, mean_halfwidth};
+use crate::figure::{
+    self, BandKind, Figure, MIN_BAND_SEEDS, Panel, Series, mean_band, mean_halfwidth,
+};
 use crate::folder::{CONFIG_FILE, Log, SUMMARY_FILE, Summary, is_complete};
 use crate::reproduce::{Experiment, ReproduceOptions, Setting, TABLE_VARIANTS};
 use crate::spec::{EnvName, RunSpec};
@@ -165,10 +167,10 @@ fn series(
         .collect();
     let curves: Vec<Vec<f64>> = group.iter().filter_map(|r| y(&r.log)).collect();
     let x = group.first()?.log.column(x_col)?;
-    let (mean, band) = mean_band(&curves);
+    let (mean, band) = mean_band(&curves, BandKind::Ci95);
     let x = x[..mean.len().min(x.len())].to_vec();
     Some(Series {
-        label: variant.to_owned(),
+        label: display_name(variant),
         x,
         mean,
         band,
@@ -256,29 +258,84 @@ impl PanelMaker<'_> {
         match what {
             Experiment::Fig51 => vec![
                 self.panel("(a) performance J(θᵗ)", "J", &col("j_explore")),
-                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma"))
+                    .clipped_at(0.0),
                 self.v_panel("(c) mean parameter vᵗ"),
             ],
             Experiment::Fig52 => vec![
                 self.panel("(a) exploratory J(θ_E)", "J", &col("j_explore")),
-                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma"))
+                    .clipped_at(0.0),
                 self.v_panel("(c) mean parameter vᵗ"),
                 self.guarantee_panel(),
                 self.panel("(e) target J(θ_T)", "J", &col("j_target")),
-                self.panel("(f) budget Bᵗ", "B", &col("budget")),
+                with_zero_line(self.panel("(f) budget Bᵗ", "B", &col("budget"))),
             ],
             Experiment::Fig53 => vec![
                 self.panel("(a) exploratory J(θ_E)", "J", &col("j_explore")),
                 self.panel("(b) target J(θ_T)", "J", &col("j_target")),
                 self.v_panel("(c) mean parameter vᵗ"),
-                self.panel("(d) standard deviation σᵗ", "σ", &col("sigma")),
+                self.panel("(d) standard deviation σᵗ", "σ", &col("sigma"))
+                    .clipped_at(0.0),
             ],
             Experiment::Fig54 | Experiment::Table51 => vec![
                 self.panel("(a) performance J(θᵗ)", "J", &col("j_explore")),
-                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma")),
+                self.panel("(b) standard deviation σᵗ", "σ", &col("sigma"))
+                    .clipped_at(0.0),
             ],
         }
     }
+}
+
+/// Panels per row for `n` panels: all in one row up to three, 2 × 2 for four, rows of
+/// three beyond, so that no grid cell is left empty for the counts the figures use.
+fn grid_columns(n: usize) -> usize {
+    match n {
+        0..=3 => n.max(1),
+        4 => 2,
+        _ => 3,
+    }
+}
+
+/// The budget panel `p` with its B = 0 line: the safety requirement of the budget-based
+/// variants is Bᵗ ≥ 0 (Definition 4.3, Sec 4.2.2).
+fn with_zero_line(mut p: Panel) -> Panel {
+    p.hlines.push(("B = 0".into(), 0.0));
+    p
+}
+
+/// The name under which the thesis shows a variant or algorithm (SEPG-MI, SEPG-LB-I, …,
+/// G(PO)MDP-Adam); names it does not know are kept as they are.
+pub fn display_name(variant: &str) -> String {
+    let short = variant.strip_prefix("sepg-").unwrap_or(variant);
+    let known = match short {
+        "mi" => Some("SEPG-MI"),
+        "lb1" => Some("SEPG-LB-I"),
+        "lb2" => Some("SEPG-LB-II"),
+        "lv" => Some("SEPG-LV"),
+        "zv" => Some("SEPG-ZV"),
+        "sim" => Some("SEPG-SIM"),
+        "naive-w" => Some("SEPG naive w"),
+        "gpomdp-adam" => Some("G(PO)MDP-Adam"),
+        "gpomdp-const" => Some("G(PO)MDP"),
+        "adastep" => Some("adaptive step (fixed σ)"),
+        _ => None,
+    };
+    if let Some(k) = known {
+        return k.to_owned();
+    }
+    if let Some(lr) = short.strip_prefix("adam-") {
+        return format!("G(PO)MDP-Adam, α = {lr}");
+    }
+    if let Some(a) = short.strip_prefix("const-") {
+        return format!("G(PO)MDP, α = {a}");
+    }
+    if let Some(nu) = short.strip_prefix("sim-")
+        && let Some((p, q)) = nu.split_once("of")
+    {
+        return format!("SEPG-SIM, ν = {p}/{q}");
+    }
+    variant.to_owned()
 }
 
 /// The figures of experiment `what` (one per preset) with their file stems.
@@ -312,15 +369,12 @@ fn figures(
         let panels = maker.panels(what);
         let seeds = seed_count(&file.spec.seeds);
         let title = format!(
-            "{} — {}, σ⁰ = {sigma0}, {seeds} seeds, δ = {delta} (mean, 95% band)",
+            "{} — {}, σ⁰ = {sigma0}, {seeds} seeds, δ = {delta} ({})",
             what.name(),
             preset.name(),
+            BandKind::Ci95.describe(),
         );
-        let columns = if panels.len() > 4 {
-            3
-        } else {
-            panels.len().min(2)
-        };
+        let columns = grid_columns(panels.len());
         let stem = if what == Experiment::Fig54 {
             what.name().to_owned()
         } else {
@@ -386,14 +440,25 @@ const PANELS: [(&str, &str, &str); 4] = [
     ("budget", "budget Bᵗ", "B"),
 ];
 
+/// The panel of `col` with its reference line (B = 0) and floor (σ ≥ 0).
+fn finish_panel(col: &str, panel: Panel) -> Panel {
+    match col {
+        "budget" => with_zero_line(panel),
+        "sigma" => panel.clipped_at(0.0),
+        _ => panel,
+    }
+}
+
 fn one_run(dir: &Path) -> Result<Figure> {
     let log = Log::read_run(dir)?;
     let x = log
         .column("iteration")
         .ok_or_else(|| Error::invalid(format!("{}: log has no iteration column", dir.display())))?;
-    let name = RunSpec::from_file(&dir.join(CONFIG_FILE))?
-        .name
-        .unwrap_or_default();
+    let name = display_name(
+        &RunSpec::from_file(&dir.join(CONFIG_FILE))?
+            .name
+            .unwrap_or_default(),
+    );
     let panels = PANELS
         .iter()
         .map(|&(col, title, y)| {
@@ -417,13 +482,14 @@ fn one_run(dir: &Path) -> Result<Figure> {
                     band: None,
                 });
             }
-            Panel {
+            let panel = Panel {
                 title: title.into(),
                 x_label: "iteration".into(),
                 y_label: y.into(),
                 series,
                 hlines: Vec::new(),
-            }
+            };
+            finish_panel(col, panel)
         })
         .collect();
     let complete = if is_complete(dir) {
@@ -438,14 +504,20 @@ fn one_run(dir: &Path) -> Result<Figure> {
     })
 }
 
-fn sweep_figure(dir: &Path, file: &SweepFile) -> Result<Figure> {
+/// The figure of a sweep folder, and the fewest seeds of any of its groups.
+fn sweep_figure(dir: &Path, file: &SweepFile, band: BandKind) -> Result<(Figure, usize)> {
     let mut groups: Vec<(String, Vec<Log>)> = Vec::new();
     for r in file.shard_runs() {
         let run_dir = dir.join(&r.dir);
         if !run_dir.join(CONFIG_FILE).is_file() {
             continue;
         }
-        let label = format!("{}/{}/σ⁰={}", r.preset.name(), r.variant, r.sigma0);
+        let label = format!(
+            "{}, {}, σ⁰ = {}",
+            r.preset.name(),
+            display_name(&r.variant),
+            r.sigma0
+        );
         let log = Log::read_run(&run_dir)?;
         match groups.iter_mut().find(|(l, _)| *l == label) {
             Some((_, logs)) => logs.push(log),
@@ -458,6 +530,7 @@ fn sweep_figure(dir: &Path, file: &SweepFile) -> Result<Figure> {
             dir.display()
         )));
     }
+    let fewest = groups.iter().map(|(_, l)| l.len()).min().unwrap_or(0);
     let panels = PANELS
         .iter()
         .map(|&(col, title, y)| {
@@ -469,7 +542,7 @@ fn sweep_figure(dir: &Path, file: &SweepFile) -> Result<Figure> {
                         .iter()
                         .filter_map(|l| l.column("iteration"))
                         .min_by_key(Vec::len)?;
-                    let (mean, band) = mean_band(&curves);
+                    let (mean, band) = mean_band(&curves, band);
                     Some(Series {
                         label: label.clone(),
                         x: x[..mean.len()].to_vec(),
@@ -478,29 +551,43 @@ fn sweep_figure(dir: &Path, file: &SweepFile) -> Result<Figure> {
                     })
                 })
                 .collect();
-            Panel {
+            let panel = Panel {
                 title: title.into(),
                 x_label: "iteration".into(),
                 y_label: y.into(),
                 series,
                 hlines: Vec::new(),
-            }
+            };
+            finish_panel(col, panel)
         })
         .collect();
-    Ok(Figure {
-        title: format!("{} (mean and 95% band across seeds)", dir.display()),
+    let fig = Figure {
+        title: format!("{} ({})", dir.display(), band.describe()),
         panels,
         columns: 2,
-    })
+    };
+    Ok((fig, fewest))
+}
+
+/// What `sepg plot` wrote, and what the reader of the figure should be warned about.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Plotted {
+    /// The files written.
+    pub paths: Vec<PathBuf>,
+    /// Warnings for the user (a band over fewer than [`MIN_BAND_SEEDS`] seeds).
+    pub warnings: Vec<String>,
 }
 
 /// Plots performance, σ, v and budget of the run or sweep folder `dir` into `out` (.png or
-/// .svg), or into `dir/plot.png` and `dir/plot.svg`; returns the files written.
+/// .svg), or into `dir/plot.png` and `dir/plot.svg`. A sweep's groups are drawn as means
+/// across seeds with bands of kind `band`, warned about when a group has fewer than
+/// [`MIN_BAND_SEEDS`] seeds.
 ///
 /// # Errors
 /// [`Error::Invalid`] for a folder that is neither a run nor a sweep, or an output file that
 /// is not .png or .svg; [`Error::Failed`] when drawing or writing fails.
-pub fn plot(dir: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>> {
+pub fn plot(dir: &Path, out: Option<&Path>, band: BandKind) -> Result<Plotted> {
     if let Some(out) = out
         && !matches!(
             out.extension().and_then(|e| e.to_str()),
@@ -512,8 +599,17 @@ pub fn plot(dir: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>> {
             out.display()
         )));
     }
+    let mut warnings = Vec::new();
     let fig = if dir.join(SWEEP_FILE).is_file() {
-        sweep_figure(dir, &SweepFile::read(dir)?)?
+        let (fig, fewest) = sweep_figure(dir, &SweepFile::read(dir)?, band)?;
+        if band != BandKind::None && fewest < MIN_BAND_SEEDS {
+            warnings.push(format!(
+                "a group has only {fewest} seed(s): its band rests on {} degree(s) of freedom \
+                 and says little; use {MIN_BAND_SEEDS} seeds or more, or --band none",
+                fewest.saturating_sub(1)
+            ));
+        }
+        fig
     } else if dir.join(CONFIG_FILE).is_file() {
         one_run(dir)?
     } else {
@@ -522,11 +618,38 @@ pub fn plot(dir: &Path, out: Option<&Path>) -> Result<Vec<PathBuf>> {
             dir.display()
         )));
     };
-    match out {
+    let paths = match out {
         Some(out) => {
             figure::save(&fig, out)?;
-            Ok(vec![out.to_path_buf()])
+            vec![out.to_path_buf()]
         }
-        None => Ok(figure::save_both(&fig, dir, "plot")?.to_vec()),
+        None => figure::save_both(&fig, dir, "plot")?.to_vec(),
+    };
+    Ok(Plotted { paths, warnings })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thesis_names_and_grids() {
+        for (v, shown) in [
+            ("mi", "SEPG-MI"),
+            ("sepg-lb1", "SEPG-LB-I"),
+            ("lb2", "SEPG-LB-II"),
+            ("gpomdp-adam", "G(PO)MDP-Adam"),
+            ("adam-1e-4", "G(PO)MDP-Adam, α = 1e-4"),
+            ("sim-1of3", "SEPG-SIM, ν = 1/3"),
+            ("my-variant", "my-variant"),
+        ] {
+            assert_eq!(display_name(v), shown);
+        }
+        // Figures 5.1–5.4 have 3, 6, 4 and 2 panels: no grid cell is left empty.
+        for n in [2, 3, 4, 6] {
+            assert_eq!(n % grid_columns(n), 0, "{n} panels");
+        }
+        let b = with_zero_line(Panel::default());
+        assert_eq!(b.hlines, vec![("B = 0".to_owned(), 0.0)]);
     }
 }
