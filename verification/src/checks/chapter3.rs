@@ -60,6 +60,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
         false_alarm_rate: EXACT_FAR.into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 

@@ -112,6 +112,7 @@ fn meta(id: &str, statement: &str, claim: &str, kind: ClaimKind) -> CheckMeta {
         false_alarm_rate: "0: exact arithmetic".into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 

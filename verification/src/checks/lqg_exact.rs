@@ -554,6 +554,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str) -> CheckMeta {
         false_alarm_rate: FAR.into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 

@@ -819,6 +819,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
         ),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 
