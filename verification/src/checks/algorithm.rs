@@ -267,6 +267,7 @@ fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
         Comparison::new(v_star, -0.615),
     )];
     let mut figures = Vec::new();
+    let mut lqg1d_j = -7.753;
     for (preset, model) in [("lqg", LqgModel::thesis()), ("lqg1d", LqgModel::lqg1d())] {
         let Ok(opt) =
             ClosedFormOracle::new(&model.with_clipping(false)).and_then(|o| o.optimal_gain())
@@ -282,10 +283,42 @@ fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
             value: format!("{}, {}", fmt_f64(opt.v[0]), fmt_f64(opt.j_deterministic)),
         });
         if preset == "lqg1d" {
+            lqg1d_j = opt.j_deterministic;
             comparisons.push((
                 "lqg1d: J(v*, −∞) vs printed −7.753".into(),
                 Comparison::new(opt.j_deterministic, -7.753),
             ));
+        }
+    }
+    // The thesis leaves the transition noise η₀ open. J(v*) of the unclipped infinite-horizon
+    // LQG is affine in η₀² (J = −E[s₀ᵀPs₀] − γ/(1−γ)·P·η₀² for the scalar case), so the η₀ at
+    // which `lqg` reproduces a value follows from two evaluations.
+    let lqg_j = |eta: f64| -> Option<(f64, f64)> {
+        let model = LqgModel::thesis()
+            .with_clipping(false)
+            .with_noise(nalgebra::DVector::from_element(1, eta))
+            .ok()?;
+        let opt = ClosedFormOracle::new(&model).ok()?.optimal_gain().ok()?;
+        Some((opt.v[0], opt.j_deterministic))
+    };
+    if let (Some((_, j_zero)), Some((_, j_one))) = (lqg_j(0.0), lqg_j(1.0)) {
+        let slope = j_zero - j_one;
+        for (what, target) in [("the printed −7.753", -7.753), ("lqg1d's J(v*)", lqg1d_j)] {
+            let eta = ((j_zero - target) / slope).sqrt();
+            if let Some((v, j)) = lqg_j(eta) {
+                comparisons.push((
+                    format!("lqg with η₀ = {eta:.15}: J(v*, −∞) vs printed −7.753"),
+                    Comparison::new(j, -7.753),
+                ));
+                comparisons.push((
+                    format!("lqg with η₀ = {eta:.15}: v* vs printed −0.615"),
+                    Comparison::new(v, -0.615),
+                ));
+                figures.push(Figure {
+                    name: format!("η₀ at which lqg reproduces {what}; J(v*, −∞) there"),
+                    value: format!("{eta:.15}, {}", fmt_f64(j)),
+                });
+            }
         }
     }
     let mut eval = fixed(ctx, &comparisons);
@@ -293,63 +326,93 @@ fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
     eval
 }
 
-/// |v_T − v*| after `iterations` exact iterations (unclipped closed form, fast).
-fn final_error(req: Requirement, sigma0: f64, iterations: u64) -> Option<f64> {
+/// |v_t − v*| at the checkpoints t of one exact run (unclipped lqg1d, closed form, fast).
+fn errors_at(req: Requirement, sigma0: f64, checkpoints: &[u64]) -> Option<Vec<f64>> {
     let gamma: f64 = 0.99;
     let v_star = (1.0 - (1.0 + 4.0 * gamma * gamma).sqrt()) / (2.0 * gamma);
+    let last = *checkpoints.last()?;
     let records = run(
         Preset::Lqg1d,
         false,
         req,
         sigma0,
         GradientMode::Exact,
-        iterations,
+        last,
         0,
     )?;
-    let last = records.last()?;
-    Some((last.v[0] - v_star).abs())
+    checkpoints
+        .iter()
+        .map(|&t| {
+            let r = records.get(usize::try_from(t).ok()?.checked_sub(1)?)?;
+            Some((r.v[0] - v_star).abs())
+        })
+        .collect()
 }
 
+/// The qualitative claims of Table 5.1 that the published table shows in every row and the
+/// text states (Section 5.1.2: "MI is in general the slowest to converge"; "our algorithms
+/// perform better with higher initial values of σ"), checked at five checkpoints of one run so
+/// that a claim that holds only for some T fails.
 fn table_5_1(ctx: &CheckContext<'_>) -> Evaluation {
     let t = u64::from(ctx.cases);
-    let err = |req, s| final_error(req, s, t);
-    let (Some(mi), Some(lb1), Some(lb2), Some(lb2_small)) = (
+    let checkpoints: Vec<u64> = (1..=5).map(|k| k * t / 5).collect();
+    let err = |req, s| errors_at(req, s, &checkpoints);
+    let lb1 = Requirement::LbI { nu: 0.5 };
+    let others = [
+        ("LB-I", lb1),
+        ("LB-II", Requirement::LbII),
+        ("LV", Requirement::Lv),
+        ("ZV", Requirement::Zv),
+    ];
+    let (Some(mi), Some(mi_small), Some(lb1_small)) = (
         err(Requirement::Mi, 1.0),
-        err(Requirement::LbI { nu: 0.5 }, 1.0),
-        err(Requirement::LbII, 1.0),
-        err(Requirement::LbII, 0.1),
+        err(Requirement::Mi, 0.1),
+        err(lb1, 0.1),
     ) else {
         return fixed(ctx, &[]);
     };
-    let mut eval = fixed(
-        ctx,
-        &[
-            (
-                "|v−v*|: LB-I (σ⁰ = 1) ≤ MI (σ⁰ = 1)".into(),
-                Comparison::new(lb1, mi),
-            ),
-            (
-                "|v−v*|: LB-II ≤ LB-I (σ⁰ = 1)".into(),
-                Comparison::new(lb2, lb1),
-            ),
-            (
-                "|v−v*|: LB-II σ⁰ = 1 ≤ LB-II σ⁰ = 0.1".into(),
-                Comparison::new(lb2, lb2_small),
-            ),
-        ],
-    );
-    eval.figures.push(Figure {
-        name: format!(
-            "|v_T − v*| after T = {t} exact iterations: MI, LB-I, LB-II, LB-II (σ⁰ = 0.1)"
-        ),
-        value: format!(
-            "{}, {}, {}, {}",
-            fmt_f64(mi),
-            fmt_f64(lb1),
-            fmt_f64(lb2),
-            fmt_f64(lb2_small)
-        ),
-    });
+    let mut comparisons = Vec::new();
+    let mut figures = Vec::new();
+    let mut lb1_big = None;
+    for (name, req) in others {
+        let Some(e) = err(req, 1.0) else {
+            return fixed(ctx, &[]);
+        };
+        for (k, (&tk, &x)) in checkpoints.iter().zip(&e).enumerate() {
+            comparisons.push((
+                format!("T = {tk}: |v−v*| of {name} ≤ MI (σ⁰ = 1)"),
+                Comparison::new(x, mi[k]),
+            ));
+        }
+        figures.push(Figure {
+            name: format!("|v_T − v*| of {name}, σ⁰ = 1, at T = {checkpoints:?}"),
+            value: e.iter().map(|x| fmt_f64(*x)).collect::<Vec<_>>().join(", "),
+        });
+        if name == "LB-I" {
+            lb1_big = Some(e);
+        }
+    }
+    let Some(lb1_big) = lb1_big else {
+        return fixed(ctx, &[]);
+    };
+    for (k, &tk) in checkpoints.iter().enumerate() {
+        comparisons.push((
+            format!("T = {tk}: |v−v*| of MI, σ⁰ = 1 ≤ σ⁰ = 0.1"),
+            Comparison::new(mi[k], mi_small[k]),
+        ));
+        comparisons.push((
+            format!("T = {tk}: |v−v*| of LB-I, σ⁰ = 1 ≤ σ⁰ = 0.1"),
+            Comparison::new(lb1_big[k], lb1_small[k]),
+        ));
+    }
+    for (name, e) in [("MI, σ⁰ = 1", &mi), ("MI, σ⁰ = 0.1", &mi_small), ("LB-I, σ⁰ = 0.1", &lb1_small)] {
+        figures.push(Figure {
+            name: format!("|v_T − v*| of {name} at T = {checkpoints:?}"),
+            value: e.iter().map(|x| fmt_f64(*x)).collect::<Vec<_>>().join(", "),
+        });
+    }
+    let mut eval = fixed(ctx, &comparisons);
+    eval.figures.extend(figures);
     eval
 }
 
@@ -460,7 +523,8 @@ pub(crate) fn checks() -> Vec<Check> {
         "Numerical claims v* ≈ −0.615 and J(v*, −∞) ≈ −7.753 (Chapter 5)",
         "Section 5.1, Table 5.1",
         "v* = (1 − √(1+4γ²))/(2γ) = −0.615 to the printed precision on both presets; \
-         J(v*, −∞) = −7.753 on lqg1d (lqg gives −1.0768, see the figures).",
+         J(v*, −∞) = −7.753 on lqg1d, and on lqg with the transition noise η₀ that reproduces it \
+         (lqg without noise gives −1.0768, see the figures).",
         "discounted Riccati iteration and closed-form J of the unclipped presets (ClosedFormOracle)",
     );
     vs.kind = ClaimKind::Equality;
@@ -470,31 +534,44 @@ pub(crate) fn checks() -> Vec<Check> {
     };
     vs.sampling = "deterministic".into();
     vs.false_alarm_rate = "0: the tolerance is half a unit of the printed last digit".into();
-    vs.notes = "Holds: the printed −7.753 is lqg1d's value, not that of the thesis's stated \
-        setup (lqg, J(v*) = −1.0768)."
+    vs.notes = "Holds, but does not identify the setup: the printed −7.753 is lqg1d's value \
+        (no transition noise), and also the value of the thesis's stated setup (lqg) with \
+        transition noise η₀ = 0.28898… (figures give η₀ to full precision), which the thesis \
+        leaves open; without noise lqg gives −1.0768. v* does not depend on η₀ (certainty \
+        equivalence)."
+        .into();
+    vs.basis = "theory: v* = (1 − √(1+4γ²))/(2γ) from the scalar discounted Riccati equation, \
+        and J(v*) = −E[s₀²]P − γ/(1−γ)·P·η₀² in closed form; the check compares the printed \
+        values with the oracle's Riccati iteration"
         .into();
     let mut t51 = meta(
         "table-5.1-ordering",
         "Table 5.1's qualitative ordering",
-        "Section 5.1.3, Table 5.1",
-        "After T exact iterations on lqg1d: |v−v*| of LB-I ≤ MI; LB-II (type-II) ≤ LB-I (type-I); \
-         SEPG LB-II with σ⁰ = 1 ≤ with σ⁰ = 0.1 (larger σ⁰ helps).",
+        "Section 5.1.2, Table 5.1",
+        "With exact gradients on lqg1d, at every checkpoint T ∈ {T/5, 2T/5, …, T}: |v−v*| of \
+         LB-I, LB-II, LV and ZV ≤ that of MI (σ⁰ = 1); |v−v*| of MI and of LB-I with σ⁰ = 1 ≤ \
+         with σ⁰ = 0.1.",
         "|v_T − v*| of exact-gradient runs (unclipped closed-form oracle, v* = −0.6153)",
     );
     t51.kind = ClaimKind::UpperBound;
     t51.sampling = "exact SEPG on unclipped lqg1d, v⁰ = −0.1, H = 20; the case count is the \
-        number of iterations T = 1000 in both modes (shortened runs; the thesis ran 10,000 sampled \
-        iterations)"
+        last checkpoint T (the published table uses 10,000 sampled iterations)"
         .into();
-    t51.cases_quick = 1000;
-    t51.cases_full = 1000;
+    t51.cases_quick = 2000;
+    t51.cases_full = 10_000;
     t51.tolerance = Tolerance { abs: 0.0, rel: 0.0 };
     t51.false_alarm_rate = "0: deterministic exact runs".into();
-    t51.notes = "Holds at T = 1000 (same T in quick and full mode). Measured once at T = 5000: \
-        MI 0.5041, LB-I 0.4105, LB-II 0.4260, LB-II with σ⁰ = 0.1 0.4722, so MI stays slowest and \
-        a larger σ⁰ still helps, but LB-I overtakes LB-II: in the exact setting the type-II \
-        advantage is an early-iteration effect. The thesis's table is sampled (10,000 \
-        iterations, 95% upper confidence bounds over seeds); this check uses exact gradients."
+    t51.notes = "Holds. Only the orderings the published table shows in every row are asserted: \
+        MI has the largest |v−v*| of the SEPG columns at every σ⁰, and MI and LB-I improve \
+        monotonically with σ⁰. The published row σ⁰ = 1 has LB-I (0.01) below LB-II (0.021), so \
+        no ordering among the faster variants is asserted; with exact gradients LB-I and LB-II \
+        change order between T = 1000 and T = 5000."
+        .into();
+    t51.basis = "independent computation: the published Table 5.1 (orderings present in every \
+        row) and the text of Section 5.1.2; theory supports both: a type-I requirement \
+        C = J(θ⁰) − J(θ^t) ≤ 0 and a type-II requirement C = −B ≤ 0 give λ ≥ 1, so their safe \
+        steps contain MI's at the same θ, and c(σ), d(σ) decrease in σ, so larger σ allows \
+        larger steps"
         .into();
     vec![
         Check::new(mi, mi_monotone),
