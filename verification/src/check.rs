@@ -150,7 +150,10 @@ impl Outcome {
         );
         match self {
             Outcome::Holds { max_error } => {
-                format!("holds within tolerance {tol} (max error {})", fmt_f64(*max_error))
+                format!(
+                    "holds within tolerance {tol} (max error {})",
+                    fmt_f64(*max_error)
+                )
             }
             Outcome::HoldsWithMargin {
                 margin,

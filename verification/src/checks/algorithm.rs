@@ -35,7 +35,9 @@ fn run(
     iterations: u64,
     seed: u64,
 ) -> Option<Vec<Record>> {
-    run_with_budget(preset, clipped, req, sigma0, gradient, iterations, seed, None)
+    run_with_budget(
+        preset, clipped, req, sigma0, gradient, iterations, seed, None,
+    )
 }
 
 /// [`run`] from v⁰ (default −0.1 when `None`) with an initial budget B⁰.
@@ -474,7 +476,11 @@ fn table_5_1(ctx: &CheckContext<'_>) -> Evaluation {
             Comparison::new(lb1_big[k], lb1_small[k]),
         ));
     }
-    for (name, e) in [("MI, σ⁰ = 1", &mi), ("MI, σ⁰ = 0.1", &mi_small), ("LB-I, σ⁰ = 0.1", &lb1_small)] {
+    for (name, e) in [
+        ("MI, σ⁰ = 1", &mi),
+        ("MI, σ⁰ = 0.1", &mi_small),
+        ("LB-I, σ⁰ = 0.1", &lb1_small),
+    ] {
         figures.push(Figure {
             name: format!("|v_T − v*| of {name} at T = {checkpoints:?}"),
             value: e.iter().map(|x| fmt_f64(*x)).collect::<Vec<_>>().join(", "),

@@ -714,9 +714,10 @@ pub(crate) fn checks() -> Vec<Check> {
         (no sepg-bounds code); and Richardson-extrapolated central differences (h = 1e-2, 2e-2) \
         of that harness-side L(v, w) = g²/(4mc(e^w))"
         .into();
-    gl.basis = "theory: Corollary 4.4's L differentiated by the chain rule, computed independently \
+    gl.basis =
+        "theory: Corollary 4.4's L differentiated by the chain rule, computed independently \
         of the code under test"
-        .into();
+            .into();
     gl.tolerance = Tolerance {
         abs: 1e-13,
         rel: 1e-5,
