@@ -30,8 +30,8 @@ A mutant that does not compile is reported as "does not compile" (not counted). 
 the failing tests are recorded, so a mutant caught only by a single-seed performance test can
 be spotted in the report.
 
-The scratch copy lives in --work (default /tmp/sepg-mutation): the working tree is copied to
-WORK/src (without target/ and .git), and WORK/target starts as a copy of the repository's
+The scratch copy lives in --work (default /tmp/sepg-mutation): the working tree's tracked and
+untracked files (git ls-files) are copied to WORK/src, and WORK/target starts as a copy of the repository's
 release target/ so that dependencies are not rebuilt. Run it niced, in the background:
 
     nice -n 10 python3 scripts/mutants/run.py > mutation.log 2>&1 &
@@ -70,6 +70,22 @@ def parse_mutant(path):
         "from": m.group(1),
         "to": m.group(2),
     }
+
+
+def copy_tree(dest):
+    """Copies the repository's tracked and untracked (not ignored) files to dest, keeping
+    modification times (so that cargo does not rebuild unchanged crates)."""
+    listed = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=REPO,
+                            check=True, capture_output=True).stdout.decode().split("\0")
+    if os.path.exists(dest):
+        shutil.rmtree(dest)
+    for rel in filter(None, listed):
+        s = os.path.join(REPO, rel)
+        if not os.path.isfile(s):
+            continue
+        d = os.path.join(dest, rel)
+        os.makedirs(os.path.dirname(d), exist_ok=True)
+        shutil.copy2(s, d)
 
 
 def rust_files(root):
@@ -183,8 +199,7 @@ def main():
     work = os.path.abspath(args.work)
     src = os.path.join(work, "src")
     os.makedirs(work, exist_ok=True)
-    subprocess.run(["rsync", "-a", "--delete", "--exclude", "/target", "--exclude", "/.git",
-                    "--exclude", "/fuzz/target", REPO + "/", src + "/"], check=True)
+    copy_tree(src)
     target = os.path.join(work, "target")
     if not os.path.exists(target) and os.path.exists(os.path.join(REPO, "target", "release")):
         os.makedirs(target)
