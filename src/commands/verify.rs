@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use sepg_verification::{CheckResult, Outcome, Report, RunConfig, fmt_f64, registry, run_checks};
+use sepg_verification::{CheckResult, Report, RunConfig, registry, run_checks};
 
 use crate::cli::CliError;
 use crate::output::write_atomic;
@@ -35,19 +35,7 @@ pub struct VerifyArgs {
 }
 
 fn outcome_text(r: &CheckResult) -> String {
-    match &r.outcome {
-        Outcome::Holds { max_error } => format!("holds (max error {})", fmt_f64(*max_error)),
-        Outcome::HoldsWithMargin {
-            margin,
-            relative_margin,
-        } => format!(
-            "holds with margin {} (relative {})",
-            fmt_f64(*margin),
-            fmt_f64(*relative_margin)
-        ),
-        Outcome::Violated { amount, .. } => format!("violated by {}", fmt_f64(*amount)),
-        Outcome::Inconclusive { reason } => format!("inconclusive: {reason}"),
-    }
+    r.outcome.describe(&r.meta.tolerance)
 }
 
 fn summary(report: &Report) -> String {

@@ -130,6 +130,46 @@ impl Outcome {
         )
     }
 
+    /// One-line description with the tolerance used: "holds within tolerance T …" for a hold
+    /// (the tightest slack may be negative but inside T), "violated by …" otherwise.
+    ///
+    /// # Example
+    /// ```
+    /// # use sepg_verification::{Outcome, Tolerance};
+    /// let t = Tolerance { abs: 1e-10, rel: 1e-9 };
+    /// let o = Outcome::HoldsWithMargin { margin: -1.1e-16, relative_margin: -1e-14 };
+    /// let text = o.describe(&t);
+    /// assert!(text.starts_with("holds within tolerance 1.000000e-10 + 1.000000e-9"));
+    /// assert!(!text.contains("holds with margin"));
+    /// ```
+    pub fn describe(&self, tolerance: &Tolerance) -> String {
+        let tol = format!(
+            "{} + {}·max(|truth|, |claimed|)",
+            fmt_f64(tolerance.abs),
+            fmt_f64(tolerance.rel)
+        );
+        match self {
+            Outcome::Holds { max_error } => {
+                format!(
+                    "holds within tolerance {tol} (max error {})",
+                    fmt_f64(*max_error)
+                )
+            }
+            Outcome::HoldsWithMargin {
+                margin,
+                relative_margin,
+            } => format!(
+                "holds within tolerance {tol} (tightest slack {}, relative {})",
+                fmt_f64(*margin),
+                fmt_f64(*relative_margin)
+            ),
+            Outcome::Violated { amount, .. } => {
+                format!("violated by {} (tolerance {tol})", fmt_f64(*amount))
+            }
+            Outcome::Inconclusive { reason } => format!("inconclusive: {reason}"),
+        }
+    }
+
     /// Short label: `holds`, `violated` or `inconclusive`.
     ///
     /// # Example
@@ -195,6 +235,12 @@ pub struct CheckMeta {
     pub expected: Expected,
     /// Explanation of the expected outcome (and the erratum for a violation).
     pub notes: String,
+    /// Where the expected outcome comes from: `theory: …` (a proof, or a closed-form
+    /// counterexample) or `independent computation: …` (a computation that does not use the
+    /// code under test, e.g. a long exact run or a published table), never the check's own
+    /// measurement alone.
+    #[serde(default)]
+    pub basis: String,
 }
 
 /// What a check's body returns: the outcome, the number of cases evaluated and extra figures.

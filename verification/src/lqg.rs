@@ -78,6 +78,19 @@ impl Task {
         self.eval(v, w).map(|e| e.j)
     }
 
+    /// Exact J_H of the policy N(v s, e^{2w}), or of the deterministic policy a = v s when
+    /// `w` is `None`.
+    pub(crate) fn j_of(&self, v: f64, w: Option<f64>) -> Option<f64> {
+        match w {
+            Some(w) => self.j(v, w),
+            None => self
+                .oracle
+                .evaluate(&[v], &Exploration::Deterministic, Horizon::Finite(HORIZON))
+                .ok()
+                .map(|e| e.j),
+        }
+    }
+
     /// The environment for rollouts (same model, horizon H).
     pub(crate) fn env(&self) -> Option<LqgEnv> {
         LqgEnv::new(self.model.clone())

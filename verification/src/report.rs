@@ -82,7 +82,8 @@ fn kind_label(k: ClaimKind) -> &'static str {
     }
 }
 
-/// One-line figure summarising an outcome.
+/// One-line figure summarising an outcome for the summary table (the tolerance is printed in
+/// the check's section).
 fn outcome_figure(o: &Outcome) -> String {
     match o {
         Outcome::Holds { max_error } => format!("max error {}", fmt_f64(*max_error)),
@@ -90,7 +91,7 @@ fn outcome_figure(o: &Outcome) -> String {
             margin,
             relative_margin,
         } => format!(
-            "margin {} (relative {})",
+            "within tolerance; tightest slack {} (relative {})",
             fmt_f64(*margin),
             fmt_f64(*relative_margin)
         ),
@@ -220,11 +221,13 @@ impl Report {
         );
         let _ = writeln!(md, "- false-alarm rate: {}", m.false_alarm_rate);
         let _ = writeln!(md, "- expected outcome: {}", expected_label(m.expected));
+        if !m.basis.is_empty() {
+            let _ = writeln!(md, "- expected outcome from: {}", m.basis);
+        }
         let _ = writeln!(
             md,
-            "- outcome: {} ({}){}",
-            r.outcome.label(),
-            outcome_figure(&r.outcome),
+            "- outcome: {}{}",
+            r.outcome.describe(&m.tolerance),
             if r.as_expected {
                 ""
             } else {

@@ -300,6 +300,7 @@ fn meta(
         false_alarm_rate: FAR_EXACT.into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 

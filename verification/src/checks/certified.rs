@@ -92,6 +92,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 the largest steps computed in f64 violate their requirement in exact \
                 arithmetic (by 1e-17 to 1e-15 relative)."
             .into(),
+        basis: String::new(),
     };
     vec![Check::new(meta, certified_steps)]
 }

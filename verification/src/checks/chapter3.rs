@@ -60,6 +60,7 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
         false_alarm_rate: EXACT_FAR.into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 
@@ -508,9 +509,9 @@ pub(crate) fn checks() -> Vec<Check> {
                 ),
                 ClaimKind::UpperBound,
                 Expected::Holds,
-                "Holds but is loose by 1/(1−γ) for the normalised d: γ/(1−γ)² is Pirotta et \
-                 al.'s constant for the unnormalised occupancy. The tight normalised form is \
-                 checked by thm-3.4-normalised-form.",
+                "Holds, as printed (no error). For the normalised d of Definition 2.5 the \
+                 sharper γ/(1−γ) also holds (thm-3.4-normalised-form); the printed γ/(1−γ)² is \
+                 Pirotta et al.'s constant, larger, hence also valid.",
             ),
             thm_3_4,
         ),

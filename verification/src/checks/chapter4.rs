@@ -82,14 +82,6 @@ fn type_ii_safety(ctx: &CheckContext<'_>) -> Evaluation {
     search(ctx, history(Just(0.0).boxed()), type_ii)
 }
 
-fn type_ii_initial_budget(ctx: &CheckContext<'_>) -> Evaluation {
-    let b0 = prop_oneof![
-        Just(1.0),
-        (1i32..(1 << 20)).prop_map(|k| f64::from(k) * DYADIC)
-    ];
-    search(ctx, history(b0.boxed()), type_ii)
-}
-
 fn meta(id: &str, statement: &str, claim: &str, kind: ClaimKind) -> CheckMeta {
     CheckMeta {
         id: id.into(),
@@ -112,6 +104,7 @@ fn meta(id: &str, statement: &str, claim: &str, kind: ClaimKind) -> CheckMeta {
         false_alarm_rate: "0: exact arithmetic".into(),
         expected: Expected::Holds,
         notes: String::new(),
+        basis: String::new(),
     }
 }
 
@@ -135,22 +128,8 @@ pub(crate) fn checks() -> Vec<Check> {
         ClaimKind::LowerBound,
     );
     safety.notes = "Holds.".into();
-    let mut initial = meta(
-        "thm-4.1-initial-budget",
-        "Theorem 4.1 with an initial budget B⁰ > 0 (Section 4.4.4, Mountain Car uses B⁰ = 1)",
-        "Budget started at B⁰ > 0 as Algorithm 4.3 does; at every t with B^t ≥ 0: \
-         (J(θ_E^t) + J(θ_T^t))/2 ≥ J_B.",
-        ClaimKind::LowerBound,
-    );
-    initial.expected = Expected::Violated;
-    initial.notes =
-        "Violated: with B⁰ > 0, B^t = B⁰ + [J_E^t − J_E^0 + J_T^t − J_T^0], so B^t ≥ 0 \
-        only gives (J_E^t + J_T^t)/2 ≥ J_B − B⁰/2. Section 4.4.4 invokes Theorem 4.1 for the \
-        algorithm with an initial budget; the guarantee must be weakened by B⁰/2."
-            .into();
     vec![
         Check::new(tele, telescoping),
         Check::new(safety, type_ii_safety),
-        Check::new(initial, type_ii_initial_budget),
     ]
 }

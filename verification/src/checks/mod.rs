@@ -9,7 +9,7 @@ mod exploring;
 mod lqg_exact;
 pub(crate) mod sampled;
 
-use crate::check::Check;
+use crate::check::{Check, Expected};
 
 /// Every check, in a deterministic order: Chapter 3, Appendix A, Chapter 4.
 ///
@@ -31,5 +31,28 @@ pub fn registry() -> Vec<Check> {
     checks.extend(algorithm::checks());
     checks.extend(certified::checks());
     checks.extend(exploring::checks());
+    for c in &mut checks {
+        if c.meta.basis.is_empty() {
+            c.meta.basis = default_basis(c.meta.expected).into();
+        }
+    }
     checks
+}
+
+/// Where the expected outcome of a check comes from when the check does not say more: a
+/// proven statement (holds) or a closed-form counterexample recorded in docs/ERRATA.md
+/// (violated).
+fn default_basis(expected: Expected) -> &'static str {
+    match expected {
+        Expected::Holds => {
+            "theory: the statement is proven (in the thesis or its source, for the reading given \
+             in the claim); the check compares it with exact or independently computed values, \
+             so a violation would be a counterexample"
+        }
+        Expected::Violated => {
+            "theory: a closed-form counterexample to the printed statement, derived by hand and \
+             recorded in docs/ERRATA.md (see the notes); the check finds one numerically"
+        }
+        Expected::Inconclusive => "theory: the statement cannot be decided by this check",
+    }
 }

@@ -10,6 +10,42 @@ pub fn c_ref(k: &TaskConstants, sigma: f64) -> f64 {
         * (a / ((2.0 * std::f64::consts::PI).sqrt() * sigma) + g / (2.0 * (1.0 - g)))
 }
 
+/// ∫ f over [lo, hi] by composite Simpson with n (even) panels.
+fn simpson(f: impl Fn(f64) -> f64, lo: f64, hi: f64, n: usize) -> f64 {
+    let h = (hi - lo) / n as f64;
+    let inner: f64 = (1..n)
+        .map(|i| f(lo + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
+        .sum();
+    (f(lo) + inner + f(hi)) * h / 3.0
+}
+
+/// ∫_ℝ |p(z)| φ(z) dz by Simpson on [0, 40] (doubled: p is even), split at the given positive
+/// roots of p so that every panel integrates a smooth function.
+fn abs_gaussian_moment(p: impl Fn(f64) -> f64 + Copy, roots: &[f64]) -> f64 {
+    let phi = |z: f64| (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let mut cuts = vec![0.0];
+    cuts.extend_from_slice(roots);
+    cuts.push(40.0);
+    2.0 * cuts
+        .windows(2)
+        .map(|w| simpson(|z| p(z).abs() * phi(z), w[0], w[1], 20_000))
+        .sum::<f64>()
+}
+
+/// K_W = ∫_ℝ |z⁴ − 4z² + 1| φ(z) dz by quadrature (roots z² = 2 ∓ √3).
+pub fn k_w_numeric() -> f64 {
+    let s3 = 3.0_f64.sqrt();
+    abs_gaussian_moment(
+        |z| z.powi(4) - 4.0 * z * z + 1.0,
+        &[(2.0 - s3).sqrt(), (2.0 + s3).sqrt()],
+    )
+}
+
+/// K_MU = ∫_ℝ |z² − 1| φ(z) dz by quadrature (root z = 1).
+pub fn k_mu_numeric() -> f64 {
+    abs_gaussian_moment(|z| z * z - 1.0, &[1.0])
+}
+
 /// ψ from a numeric maximisation of |(χ² − 4χ + 1)e^{−χ/2}| / √(2π) over χ ≥ 0.
 pub fn psi_numeric() -> f64 {
     let f = |x: f64| (x * x - 4.0 * x + 1.0).abs() * (-x / 2.0).exp();

@@ -109,19 +109,27 @@ proptest! {
         }
     }
 
-    /// Rigorous vs thesis: |f − f_T| = O(Δw³) with explicit constants; f ≥ f_T for Δw ≥ 0.
+    /// Rigorous vs thesis: |f − f_T| = O(Δw³) with explicit constants while the box term is
+    /// the larger curvature; f ≥ f_T for Δw ≥ 0 there; beyond σ = ψ|A|/K_W the difference is
+    /// the second-order term (a_ℝ − a)Δw².
     #[test]
     fn rigorous_versus_thesis(k in constants(), sigma in 1e-2..10.0_f64, x in -1.0..1.0_f64) {
         let (g, r) = (k.gamma(), k.r_max());
         let a = r * psi() * k.action_volume() / (2.0 * (1.0 - g).powi(2) * sigma);
+        let a_line = r * rigorous::k_w() / (2.0 * (1.0 - g).powi(2));
+        let excess = (a_line - a).max(0.0) * x * x;
         let big_g = g * r / (2.0 * (1.0 - g).powi(3));
         let gap = rigorous::gap(&k, sigma, x).unwrap();
         let cube = x.abs().powi(3);
-        let tol = 1e-12 * (a + big_g) * x * x;
+        let tol = 1e-12 * (a + a_line + big_g) * x * x;
         prop_assert!(-gap <= 4.0 / 3.0 * big_g * cube + tol, "rigorous ≤ thesis + (4/3)G|Δw|³");
-        prop_assert!(gap <= a * cube * x.abs().exp() + tol, "rigorous ≥ thesis − a|Δw|³e^|Δw|");
+        prop_assert!(
+            gap <= a * cube * x.abs().exp() + excess + tol,
+            "rigorous ≥ thesis − a|Δw|³e^|Δw| − (a_ℝ − a)⁺Δw²"
+        );
+        prop_assert!(gap >= excess - 4.0 / 3.0 * big_g * cube - tol);
         if x >= 0.0 {
-            prop_assert!(gap <= tol, "Δw ≥ 0: rigorous ≥ thesis");
+            prop_assert!(gap <= excess + tol, "Δw ≥ 0: rigorous ≥ thesis − (a_ℝ − a)⁺Δw²");
         }
     }
 
