@@ -62,7 +62,7 @@ fn json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&read(p)).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
-/// v* of both LQG presets, (1 − √(1 + 4γ²)) / (2γ) with γ = 0.99 (SPEC §1).
+/// v* of both LQG presets, (1 − √(1 + 4γ²)) / (2γ) with γ = 0.99 (docs/CONVENTIONS.md §1).
 fn v_star() -> f64 {
     let g: f64 = 0.99;
     (1.0 - (1.0 + 4.0 * g * g).sqrt()) / (2.0 * g)
@@ -177,7 +177,7 @@ fn flags_override_the_config_file_and_multi_dimensional_columns_are_indexed() {
         config.contains("iterations = 2") && config.contains("seed = 5"),
         "{config}"
     );
-    // Mountain Car: B⁰ defaults to 1 (SPEC §5) and state+bias features give 3 mean parameters.
+    // Mountain Car: B⁰ defaults to 1 (docs/CONVENTIONS.md §5) and state+bias features give 3 mean parameters.
     assert!(
         config.contains("budget0 = 1.0") && config.contains("features = \"state-bias\""),
         "{config}"

@@ -17,7 +17,7 @@ use sepg_mdp::oracle::{
 /// Horizon of every finite-horizon J in the harness (the experiments' H).
 pub(crate) const HORIZON: usize = 20;
 
-/// Which clipped LQG preset (SPEC §1).
+/// Which clipped LQG preset (docs/CONVENTIONS.md §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Preset {
     /// `lqg`: S, A = [−2, 2], reward −0.5(s² + a²).

@@ -8,7 +8,7 @@ const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
 /// The constants of a task that enter every closed-form bound, validated once.
 ///
 /// Build it with [`TaskConstants::new`]; only validated constants can reach the bounds
-/// (Section 4.3.1 and SPEC §1).
+/// (Section 4.3.1 and docs/CONVENTIONS.md §1).
 ///
 /// - `gamma`: discount factor γ ∈ [0, 1);
 /// - `r_max`: R, the largest absolute reward, R > 0;

@@ -1,4 +1,4 @@
-//! Greedy-coordinate updates for multi-dimensional parameters (Section 4.3.4, SPEC §4).
+//! Greedy-coordinate updates for multi-dimensional parameters (Section 4.3.4, docs/CONVENTIONS.md §4).
 //!
 //! Only the coordinate with the largest absolute partial derivative moves (ties: lowest
 //! index): v_k ← v_k + ᾱ ∇_{v_k} J for the mean, and w_h ← w_h + β̄ ∇_{w_h} L for the

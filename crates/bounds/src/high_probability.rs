@@ -1,4 +1,4 @@
-//! High-probability variants of the update bounds, Theorems 4.7–4.9 (Section 4.5, SPEC §4).
+//! High-probability variants of the update bounds, Theorems 4.7–4.9 (Section 4.5, docs/CONVENTIONS.md §4).
 //!
 //! The estimated gradients come with a confidence width ε (Assumption 4.6, ε = max_i ε_i):
 //! with probability at least 1 − δ per component, |∇ − ∇̂| ≤ ε. The corrected norms are

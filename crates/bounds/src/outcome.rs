@@ -60,7 +60,7 @@ pub enum StepOutcome {
     Feasible(SafeInterval),
     /// C > C_max: no step guarantees C ("no real solution", proofs of Thms 4.2 and 4.3).
     /// `vertex` is the step of maximal guaranteed improvement (λ = 0), which guarantees
-    /// `c_max` (SPEC §5: take it and flag the iteration).
+    /// `c_max` (docs/CONVENTIONS.md §5: take it and flag the iteration).
     Infeasible {
         /// The largest guaranteed improvement.
         c_max: f64,

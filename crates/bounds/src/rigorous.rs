@@ -1,5 +1,5 @@
 //! Rigorous lower bounds for the w-update and the v-update, with no neglected terms and no
-//! assumption on where the Gaussian density lives (SPEC §4).
+//! assumption on where the Gaussian density lives (docs/CONVENTIONS.md §4).
 //!
 //! # Derivation
 //!

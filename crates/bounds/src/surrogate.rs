@@ -1,5 +1,5 @@
 //! The surrogate objective L of Corollary 4.4 and its gradient with respect to w (Appendix B,
-//! SPEC §3).
+//! docs/CONVENTIONS.md §3).
 //!
 //! This crate follows Corollary 4.4, L = ‖∇_v J‖₂² / (4 m c(σ)). Appendix B writes
 //! L = α*‖∇_v J‖₂² / (2m) with an α* that already carries a 1/m, i.e. an extra factor 1/m; the

@@ -274,7 +274,7 @@ impl Sums {
     }
 }
 
-/// Baseline ratio with the explicit convention `0/0 = 0` (Sec 2.3.2, SPEC §3); written as a
+/// Baseline ratio with the explicit convention `0/0 = 0` (Sec 2.3.2, docs/CONVENTIONS.md §3); written as a
 /// select after the division so that it vectorises.
 #[inline(always)]
 fn ratio(num: f64, den: f64) -> f64 {

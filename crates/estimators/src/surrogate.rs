@@ -1,5 +1,5 @@
 //! The cross-fitted estimator of `∇_w L`, the gradient of the surrogate objective
-//! `L = ‖∇_v J‖² / (4 m c(σ))` (Corollary 4.4, Appendix B, SPEC §3).
+//! `L = ‖∇_v J‖² / (4 m c(σ))` (Corollary 4.4, Appendix B, docs/CONVENTIONS.md §3).
 //!
 //! `∇_w L` is a product of two gradient estimates, so the plug-in estimator is biased by the
 //! covariance of `∇̂_v J` with itself (`E‖ĝ‖² = ‖g‖² + tr Cov ĝ`). Here the batch is split into
@@ -106,7 +106,7 @@ fn row_mean(samples: &[f64], dim: usize, rows: std::ops::Range<usize>, out: &mut
 }
 
 impl Estimator {
-    /// Cross-fitted, unbiased estimate of `∇_w L` (Appendix B, SPEC §3) for a penalty
+    /// Cross-fitted, unbiased estimate of `∇_w L` (Appendix B, docs/CONVENTIONS.md §3) for a penalty
     /// coefficient `c = c(σ) > 0` and its partial derivatives `dc_dsigma[j] = ∂c/∂σ_j`.
     ///
     /// # Formula

@@ -1,4 +1,4 @@
-//! The environment abstraction, the LQG environments of SPEC §1 (`lqg`, `lqg1d`, `lqg-nd`) and
+//! The environment abstraction, the LQG environments of docs/CONVENTIONS.md §1 (`lqg`, `lqg1d`, `lqg-nd`) and
 //! the preset registry.
 //!
 //! An [`Environment`] has continuous vector states and actions, writes every result into
@@ -41,7 +41,7 @@ pub enum EnvError {
     InvalidGamma(f64),
 }
 
-/// The constants of an environment used by the bounds (SPEC §1): `R_max`, `M_φ`, `|A|`, `γ`
+/// The constants of an environment used by the bounds (docs/CONVENTIONS.md §1): `R_max`, `M_φ`, `|A|`, `γ`
 /// and the episode horizon `H`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvConstants {
@@ -53,7 +53,7 @@ pub struct EnvConstants {
     pub action_volume: f64,
     /// Discount factor `γ ∈ [0, 1)`.
     pub gamma: f64,
-    /// Default episode horizon `H` (20 for the LQG presets, SPEC §6; 999 for Mountain Car).
+    /// Default episode horizon `H` (20 for the LQG presets, docs/CONVENTIONS.md §6; 999 for Mountain Car).
     pub horizon: usize,
 }
 
@@ -135,7 +135,7 @@ pub(crate) struct ScalarLqg {
 }
 
 /// The LQG environment of an [`LqgModel`] with features `φ(s) = s` (Sec 5.1: `a ~ N(v s, σ²)`;
-/// SPEC §1 `lqg`, `lqg1d`, `lqg-nd`).
+/// docs/CONVENTIONS.md §1 `lqg`, `lqg1d`, `lqg-nd`).
 ///
 /// # Formula
 /// ```text
@@ -155,7 +155,7 @@ pub struct LqgEnv {
 }
 
 impl LqgEnv {
-    /// The environment of a validated model, with the default horizon `H = 20` (SPEC §6).
+    /// The environment of a validated model, with the default horizon `H = 20` (docs/CONVENTIONS.md §6).
     ///
     /// ```
     /// use sepg_mdp::env::{Environment, LqgEnv};
@@ -196,7 +196,7 @@ impl LqgEnv {
         })
     }
 
-    /// SPEC §1 preset `lqg` (thesis Sec 5.1 as written).
+    /// docs/CONVENTIONS.md §1 preset `lqg` (thesis Sec 5.1 as written).
     ///
     /// ```
     /// use sepg_mdp::env::{Environment, LqgEnv};
@@ -206,7 +206,7 @@ impl LqgEnv {
         LqgEnv::from_valid(LqgModel::thesis())
     }
 
-    /// SPEC §1 preset `lqg1d` (the 1-D LQG the thesis's numbers came from).
+    /// docs/CONVENTIONS.md §1 preset `lqg1d` (the 1-D LQG the thesis's numbers came from).
     ///
     /// ```
     /// use sepg_mdp::env::{Environment, LqgEnv};
@@ -284,7 +284,7 @@ impl Environment for LqgEnv {
         }
     }
 
-    /// Order (SPEC §1): `a_c = clip(a)`; `r = −(sᵀQs + a_cᵀRa_c)` on the pre-step state;
+    /// Order (docs/CONVENTIONS.md §1): `a_c = clip(a)`; `r = −(sᵀQs + a_cᵀRa_c)` on the pre-step state;
     /// `s' = clip(A s + B a_c + η)`, η drawn component by component from the environment
     /// stream (only where `noise_std > 0`). Dot products are summed from the first term on,
     /// matching the fused scalar kernel bit for bit.
@@ -356,7 +356,7 @@ fn quad_form(m: &[f64], d: usize, x: impl Fn(usize) -> f64) -> f64 {
     total
 }
 
-/// The named environment presets of SPEC §1 (`lqg-nd` is built from a model with
+/// The named environment presets of docs/CONVENTIONS.md §1 (`lqg-nd` is built from a model with
 /// [`LqgEnv::new`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Preset {

@@ -3,8 +3,8 @@
 //!
 //! - [`lqg_model`]: the LQG problem description shared with the exact oracles.
 //! - [`env`](mod@env), [`mountain_car`], [`features`]: environments, presets and feature maps
-//!   (SPEC §1).
-//! - [`policy`]: the factored Gaussian linear policy (Sec 4.3.1, 4.3.4; SPEC §2).
+//!   (docs/CONVENTIONS.md §1).
+//! - [`policy`]: the factored Gaussian linear policy (Sec 4.3.1, 4.3.4; docs/CONVENTIONS.md §2).
 //! - [`rng`], [`rollout`]: per-trajectory random streams and the deterministic parallel rollout
 //!   engine producing [`Batch`]es.
 //! - [`monte_carlo`]: Monte Carlo estimates of `J` and of paired differences of `J`.

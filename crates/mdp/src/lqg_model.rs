@@ -2,7 +2,7 @@
 //! the exact LQG oracles.
 //!
 //! The thesis's LQG (Sec 5.1) is one-dimensional; [`LqgModel`] describes the general
-//! `n`-state, `l`-action problem of SPEC §1 (`lqg-nd`), and the two presets of SPEC §1 are
+//! `n`-state, `l`-action problem of docs/CONVENTIONS.md §1 (`lqg-nd`), and the two presets of docs/CONVENTIONS.md §1 are
 //! [`LqgModel::thesis`] (`lqg`) and [`LqgModel::lqg1d`] (`lqg1d`).
 //!
 //! # Formula
@@ -142,7 +142,7 @@ impl BoxBounds {
     }
 }
 
-/// A linear-quadratic-Gaussian problem (thesis Sec 5.1; SPEC §1 `lqg`, `lqg1d`, `lqg-nd`):
+/// A linear-quadratic-Gaussian problem (thesis Sec 5.1; docs/CONVENTIONS.md §1 `lqg`, `lqg1d`, `lqg-nd`):
 /// `s' = A s + B a_c + η`, `η ~ N(0, diag(noise_std²))`, reward `r = −(sᵀQs + a_cᵀ R a_c)` on
 /// the pre-step state, `a_c` the action clipped to the action box, `s'` clipped to the state box
 /// (when [`clipping`](Self::clipping) is on), `s_0 ~ U[init_low, init_high]` per component.
@@ -164,7 +164,7 @@ pub struct LqgModel {
     pub q: DMatrix<f64>,
     /// Action cost `R` (l×l, symmetric positive semi-definite).
     pub r: DMatrix<f64>,
-    /// Per-component transition-noise standard deviations (length n, ≥ 0; default 0, SPEC §1).
+    /// Per-component transition-noise standard deviations (length n, ≥ 0; default 0, docs/CONVENTIONS.md §1).
     pub noise_std: DVector<f64>,
     /// Lower corner of the state box `S`.
     pub state_low: DVector<f64>,
@@ -178,14 +178,14 @@ pub struct LqgModel {
     pub init_low: DVector<f64>,
     /// Upper corner of the initial-state box.
     pub init_high: DVector<f64>,
-    /// Discount factor `γ ∈ [0, 1)` (default 0.99, SPEC §1).
+    /// Discount factor `γ ∈ [0, 1)` (default 0.99, docs/CONVENTIONS.md §1).
     pub gamma: f64,
     /// Whether actions and next states are clipped to their boxes (default `true`).
     pub clipping: bool,
 }
 
 impl LqgModel {
-    /// A validated model with zero transition noise, `γ = 0.99` and clipping on (SPEC §1
+    /// A validated model with zero transition noise, `γ = 0.99` and clipping on (docs/CONVENTIONS.md §1
     /// defaults); change them with [`with_noise`](Self::with_noise),
     /// [`with_gamma`](Self::with_gamma) and [`with_clipping`](Self::with_clipping).
     ///
@@ -269,7 +269,7 @@ impl LqgModel {
         )
     }
 
-    /// SPEC §1 preset `lqg`, the LQG of thesis Sec 5.1 as written: `A = B = 1`,
+    /// docs/CONVENTIONS.md §1 preset `lqg`, the LQG of thesis Sec 5.1 as written: `A = B = 1`,
     /// `Q = R = 0.5`, `S = A = [−2, 2]`, `s_0 ~ U[−2, 2]`, `γ = 0.99`, no noise.
     /// Its constants are `r_max = 4`, `m_phi = 2`, `|A| = 4`.
     ///
@@ -287,7 +287,7 @@ impl LqgModel {
         LqgModel::scalar_preset(0.5, 2.0)
     }
 
-    /// SPEC §1 preset `lqg1d`, the 1-D LQG of the public code the thesis's numbers came from:
+    /// docs/CONVENTIONS.md §1 preset `lqg1d`, the 1-D LQG of the public code the thesis's numbers came from:
     /// `A = B = 1`, `Q = R = 0.9`, `S = A = [−4, 4]`, `s_0 ~ U[−4, 4]`, `γ = 0.99`, no noise.
     /// Its constants are `r_max = 28.8`, `m_phi = 4`, `|A| = 8`.
     ///

@@ -1,4 +1,4 @@
-//! Mountain Car with the semantics of gymnasium's `MountainCarContinuous-v0` in f64 (SPEC §1;
+//! Mountain Car with the semantics of gymnasium's `MountainCarContinuous-v0` in f64 (docs/CONVENTIONS.md §1;
 //! the experiment of thesis Sec 5.2, Fig 5.4).
 //!
 //! # Formula
@@ -27,7 +27,7 @@ pub const GOAL_POSITION: f64 = 0.45;
 pub const POWER: f64 = 0.0015;
 /// Episode time limit (truncation).
 pub const TIME_LIMIT: usize = 999;
-/// `R_max` of SPEC §1: the goal reward. The action penalty `0.1·a²` uses the raw action and is
+/// `R_max` of docs/CONVENTIONS.md §1: the goal reward. The action penalty `0.1·a²` uses the raw action and is
 /// not bounded by it for `|a| > 10√10`.
 pub const R_MAX: f64 = 100.0;
 

@@ -1,4 +1,4 @@
-//! The factored Gaussian linear policy of Sec 4.3.1 and 4.3.4 (SPEC §2).
+//! The factored Gaussian linear policy of Sec 4.3.1 and 4.3.4 (docs/CONVENTIONS.md §2).
 //!
 //! For `l` action dimensions and `p` features, `μ(s) = Vᵀφ(s)` with `V` a `p × l` matrix stored
 //! flattened action-major (`v[j·p + i]` multiplies feature `i` in the mean of action `j`, as

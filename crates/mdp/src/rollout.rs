@@ -673,7 +673,7 @@ fn fill_returns_scalar<const STOCH: bool>(
     }
 }
 
-/// The fused kernel of the scalar LQG (SPEC §1 step order) on `K` trajectories in lockstep,
+/// The fused kernel of the scalar LQG (docs/CONVENTIONS.md §1 step order) on `K` trajectories in lockstep,
 /// for `limit` steps; every step goes to `sink`. `STOCH = false` is the deterministic policy
 /// (no draws from the policy stream). Returns the discounted returns.
 #[inline(always)]

@@ -1,4 +1,4 @@
-//! Environment semantics (SPEC §1) on hand-derived vectors, preset constants and the registry.
+//! Environment semantics (docs/CONVENTIONS.md §1) on hand-derived vectors, preset constants and the registry.
 
 use nalgebra::{DMatrix, DVector};
 use sepg_mdp::env::{AnyEnv, EnvError, Environment, LqgEnv, Preset};
@@ -125,7 +125,7 @@ fn resets_stay_in_their_boxes() {
     assert!(lo < -0.599 && hi > -0.401);
 }
 
-/// An independent transcription of gymnasium's `MountainCarContinuous-v0.step` (SPEC §1),
+/// An independent transcription of gymnasium's `MountainCarContinuous-v0.step` (docs/CONVENTIONS.md §1),
 /// keeping its `if` form on purpose.
 #[allow(clippy::manual_clamp)]
 fn reference_mc_step(pos: f64, vel: f64, action: f64) -> (f64, f64, f64, bool) {

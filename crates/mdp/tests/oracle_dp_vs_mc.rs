@@ -122,7 +122,7 @@ fn dp_values_agree_with_monte_carlo() {
 
 #[test]
 fn dp_derivatives_agree_with_likelihood_ratio_estimates() {
-    // Per-trajectory unbiased samples (raw-action scores, SPEC §2):
+    // Per-trajectory unbiased samples (raw-action scores, docs/CONVENTIONS.md §2):
     //   ∂_v J:  Σ_t γ^t r_t S^v_t              (G(PO)MDP)
     //   ∂_w J:  Σ_t γ^t r_t S^w_t
     //   ∂_w∂_v J = σ h − 2 ∂_v J,  h: Σ_t γ^t r_t (S^w_t/σ) S^v_t   (Appendix B, eq. B.3)

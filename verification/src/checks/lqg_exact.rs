@@ -392,7 +392,7 @@ fn thm_4_3_neglected(ctx: &CheckContext<'_>) -> Evaluation {
     eval
 }
 
-/// ∇_w L from the exact mixed derivative (Appendix B, SPEC §3).
+/// ∇_w L from the exact mixed derivative (Appendix B, docs/CONVENTIONS.md §3).
 fn grad_w_l(k: &TaskConstants, sigma: f64, e: &sepg_mdp::oracle::ExactEval) -> Option<f64> {
     surrogate::grad_w(k, sigma, &e.grad_v, &e.mixed_sigma_v()).ok()
 }
@@ -665,7 +665,7 @@ pub(crate) fn checks() -> Vec<Check> {
         .into();
     let mut t43r = meta(
         "thm-4.3-w-update-rigorous",
-        "Theorem 4.3, rigorous variant (SPEC §4: remainder at min(σ, σ'), KL direction chosen)",
+        "Theorem 4.3, rigorous variant (docs/CONVENTIONS.md §4: remainder at min(σ, σ'), KL direction chosen)",
         "Section 4.3.2 and Appendix A; sepg_bounds::rigorous",
         "For Δw = β∇_wJ with β in the rigorous safe interval: J(v, w + Δw) − J(v, w) ≥ f(Δw) \
          (sepg_bounds::rigorous::bound) and ≥ C.",
@@ -704,7 +704,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut gl = meta(
         "app-b-surrogate-gradient",
         "Appendix B (B.1) and ∂_σ∇_vJ = h − (2/σ)∇_vJ: the exact ∇_w L",
-        "Appendix B, thesis lines 1721–1750; SPEC §3",
+        "Appendix B, thesis lines 1721–1750; docs/CONVENTIONS.md §3",
         "sepg_bounds::surrogate::grad_w with the exact mixed derivative ∂_σ∇_vJ equals \
          d/dw [‖∇_vJ(v, w)‖²/(4m c(e^w))].",
     );

@@ -1039,7 +1039,7 @@ pub(crate) fn checks() -> Vec<Check> {
     a46g.basis = "theory: Student's theorem (exact coverage 1 − δ for Gaussian samples)".into();
     let mut t47 = meta(
         "thm-4.7-hp-v-update",
-        "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, SPEC §4 vertex)",
+        "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, docs/CONVENTIONS.md §4 vertex)",
         "Section 4.5, thesis lines 1300–1314",
         "With the estimated gradient and ε, the v-step at the vertex (C = C_max) and the largest \
          step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)^m (m = 1).",
@@ -1085,7 +1085,7 @@ pub(crate) fn checks() -> Vec<Check> {
         .into();
     let mut neg_s = meta(
         "thm-4.7-4.9-negative-c-sign-aware",
-        "Theorems 4.7–4.9 for C < 0 with the sign-aware interval (SPEC §4)",
+        "Theorems 4.7–4.9 for C < 0 with the sign-aware interval (docs/CONVENTIONS.md §4)",
         "Section 4.5; sepg_bounds::high_probability::HpForm::SignAware",
         "Same as thm-4.7-4.9-negative-c-printed with the sign-aware interval.",
         DP_TRUTH,

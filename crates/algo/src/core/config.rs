@@ -9,7 +9,7 @@ use crate::core::error::ConfigError;
 use crate::core::options::{SepgOptions, WDirection};
 use crate::core::state::State;
 
-/// Safety requirement of SEPG (Table 4.1, SPEC §5).
+/// Safety requirement of SEPG (Table 4.1, docs/CONVENTIONS.md §5).
 ///
 /// Type-I requirements constrain every update, J(θᵗ⁺¹) − J(θᵗ) ≥ Cᵗ (eq. 4.2), with Cᵗ split
 /// between the v-update ((1 − ν)Cᵗ, eq. 4.13) and the w-update (νCᵗ, eq. 4.14). Type-II
@@ -76,7 +76,7 @@ impl Requirement {
     }
 }
 
-/// The optimisation algorithm (SPEC §5, comparison algorithms of Chapter 5).
+/// The optimisation algorithm (docs/CONVENTIONS.md §5, comparison algorithms of Chapter 5).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Algorithm {
     /// SEPG, update (4.20): greedy-coordinate v-update with the largest safe ᾱ, w-update
@@ -238,7 +238,7 @@ pub struct SepgConfig {
     pub iterations: u64,
     /// Seed of the run; trajectory streams derive from (seed, iteration, block, index).
     pub seed: u64,
-    /// Initial budget B⁰ ≥ 0 (Algorithm 4.3; SPEC §5 default 0).
+    /// Initial budget B⁰ ≥ 0 (Algorithm 4.3; docs/CONVENTIONS.md §5 default 0).
     pub initial_budget: f64,
     /// Options of SEPG: the form and direction of the w-update, confidence widths, LB-I's
     /// requirement, alternating iterations, the reference batch of J(θ⁰), constant overrides
@@ -247,7 +247,7 @@ pub struct SepgConfig {
 }
 
 impl SepgConfig {
-    /// The reproduction defaults of SPEC §6 for `env` and `algorithm`: v⁰ = −0.1 on every
+    /// The reproduction defaults of docs/CONVENTIONS.md §6 for `env` and `algorithm`: v⁰ = −0.1 on every
     /// mean parameter, σ⁰ = 1, N = 100, H = 20, 10,000 iterations, seed 0, B⁰ = 0, sampled
     /// gradients with δ = 0.2.
     pub fn new(env: AnyEnv, algorithm: Algorithm) -> Self {
@@ -405,7 +405,7 @@ impl CheckedConfig {
         &self.inner
     }
 
-    /// The validated task constants R, M_φ, |A|, γ of the environment (SPEC §1).
+    /// The validated task constants R, M_φ, |A|, γ of the environment (docs/CONVENTIONS.md §1).
     pub fn constants(&self) -> &TaskConstants {
         &self.constants
     }

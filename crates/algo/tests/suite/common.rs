@@ -6,7 +6,7 @@ use sepg_algo::core::state::State;
 use sepg_algo::solver::PolicySolver;
 use sepg_mdp::env::{AnyEnv, LqgEnv};
 
-/// v* of both LQG presets, (1 − √(1 + 4γ²)) / (2γ) with γ = 0.99 (SPEC §1).
+/// v* of both LQG presets, (1 − √(1 + 4γ²)) / (2γ) with γ = 0.99 (docs/CONVENTIONS.md §1).
 pub fn v_star() -> f64 {
     let g: f64 = 0.99;
     (1.0 - (1.0 + 4.0 * g * g).sqrt()) / (2.0 * g)

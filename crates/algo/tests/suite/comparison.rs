@@ -5,7 +5,7 @@
 //! Exact-mode checks are deterministic (closed-form oracle, unclipped models). The optimum
 //! they are compared with is the maximiser v*_H of the exact finite-horizon J(·, σ) (H = 20),
 //! found here by golden-section search on the oracle; it differs from the infinite-horizon
-//! v* of SPEC §1 because of the horizon. Sampled checks use fixed seeds.
+//! v* of docs/CONVENTIONS.md §1 because of the horizon. Sampled checks use fixed seeds.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;

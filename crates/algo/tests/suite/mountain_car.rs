@@ -1,4 +1,4 @@
-//! Mountain Car (thesis Sec 5.2, Fig 5.4; SPEC §6): σ⁰ = 0.2, B⁰ = 1, SEPG-ZV against
+//! Mountain Car (thesis Sec 5.2, Fig 5.4; docs/CONVENTIONS.md §6): σ⁰ = 0.2, B⁰ = 1, SEPG-ZV against
 //! G(PO)MDP + Adam, gymnasium dynamics with the 999-step time limit as horizon (H = 999),
 //! state+bias features φ = [pos, vel, 1], v⁰ = −0.1, N = 100, γ = 0.99, δ = 0.2.
 //!

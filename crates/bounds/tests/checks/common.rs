@@ -98,7 +98,7 @@ pub fn close(a: f64, b: f64, rel: f64, scale: f64) -> bool {
 }
 
 /// A few task-constant sets used across the tests (the `lqg`, `lqg1d` and Mountain Car
-/// presets of SPEC §1 plus an undiscounted-ish extreme).
+/// presets of docs/CONVENTIONS.md §1 plus an undiscounted-ish extreme).
 pub fn presets() -> Vec<TaskConstants> {
     vec![
         TaskConstants::new(0.99, 4.0, 2.0, 4.0).unwrap(),

@@ -1,7 +1,7 @@
 //! Exact oracles for the expected discounted return `J(v, w)` of a linear Gaussian policy on
 //! an LQG problem, and for its derivatives.
 //!
-//! The "exact gradient" mode of SEPG (SPEC §5, the setting of thesis Sec 4.3) needs `J`,
+//! The "exact gradient" mode of SEPG (docs/CONVENTIONS.md §5, the setting of thesis Sec 4.3) needs `J`,
 //! `∇_v J`, `∇_w J` and the mixed derivative `∇_w ∇_v J` that enters `∇_w L` (Corollary 4.4,
 //! Appendix B) without estimation error. Two oracles implement the common [`ExactOracle`]
 //! trait:
@@ -212,7 +212,7 @@ pub enum OracleError {
 /// Which derivatives an evaluation must return ([`ExactOracle::evaluate_with`]); `J` is
 /// always computed.
 ///
-/// One SEPG iteration in exact mode (SPEC §5, thesis Sec 4.3) needs `∇_v J` for the mean step
+/// One SEPG iteration in exact mode (docs/CONVENTIONS.md §5, thesis Sec 4.3) needs `∇_v J` for the mean step
 /// (Theorem 4.3), and `∇_w J` with `∇_w ∇_v J` for the exploration step (the surrogate
 /// gradient `∇_w L` of Corollary 4.4 / Appendix B), but never the Hessian; the target policy
 /// of LV / ZV needs `J` only.
@@ -272,7 +272,7 @@ impl Needs {
     };
 }
 
-/// An oracle computing `J` and its derivatives exactly (SPEC §5 "exact" gradient mode, the
+/// An oracle computing `J` and its derivatives exactly (docs/CONVENTIONS.md §5 "exact" gradient mode, the
 /// setting of thesis Sec 4.3 where `∇_v J` and `∇_w J` are known).
 ///
 /// # Formula
