@@ -98,7 +98,7 @@ fn different_seeds_draw_different_cases() {
 
 #[test]
 fn every_check_meets_its_expected_outcome_in_quick_mode() {
-    // The full mode is exercised by `sepg verify` (docs/VERIFICATION.md); it takes minutes.
+    // The full mode is exercised by `sepg verify` (docs/VERIFICATION-REPORT.md); it takes minutes.
     let report = run_checks(
         &registry(),
         &RunConfig {
