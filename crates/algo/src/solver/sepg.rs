@@ -105,6 +105,7 @@ fn reference(
 /// Runs SEPG iteration `state.iteration` for `req`; `naive_w` selects the w-update along
 /// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20); `certify` selects certified steps
 /// (`sepg_bounds::certified`); `opts` the remaining choices ([`SepgOptions`]).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn iterate(
     source: &mut dyn GradientSource,
     k: &TaskConstants,
@@ -326,6 +327,7 @@ pub(crate) fn iterate(
 /// the requirement measured at its own start (LB-I: J(θ⁰) − Ĵ, times 1 − ν or ν unless
 /// `Lb1Requirement::Full`). Each half-step keeps J ≥ J(θ⁰) on its own, since
 /// J_after ≥ J_before + ν(J(θ⁰) − J_before) ≥ J(θ⁰) whenever J_before ≥ J(θ⁰).
+#[allow(clippy::too_many_arguments)]
 fn iterate_alternating(
     source: &mut dyn GradientSource,
     k: &TaskConstants,
@@ -430,6 +432,7 @@ fn iterate_alternating(
 /// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `naive`), along the
 /// direction and in the form `opts` selects; `alpha` is the latest v-step size (for the
 /// metagradient direction).
+#[allow(clippy::too_many_arguments)]
 fn w_plan(
     k: &TaskConstants,
     sigmas: &[f64],
