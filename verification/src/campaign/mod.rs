@@ -336,12 +336,29 @@ impl Exact {
         } else {
             Mp::int(1).max(&dw.neg().exp()?)
         };
+        // The real-line curvature a_ℝ = R K_W/(2(1−γ)²) with K_W = ∫_ℝ |∂²π/∂w²| da
+        // = 4(g(√(2−√3)) − g(√(2+√3))), g(z) = (z − z³) e^{−z²/2}/√(2π); the coefficient is
+        // the larger of the two (docs/ERRATA.md §27).
+        let a_line = self.r.mul(&k_w()?).div(&self.one_minus.sqr().ldexp(1))?;
+        let coefficient = a.mul(&curvature).max(&a_line);
         Some(
             dw.mul(&Mp::f(grad_w_j))
-                .sub(&a.mul(&dw.sqr()).mul(&curvature))
+                .sub(&coefficient.mul(&dw.sqr()))
                 .sub(&g.mul(&kl)),
         )
     }
+}
+
+/// K_W = ∫_ℝ |z⁴ − 4z² + 1| φ(z) dz in closed form, enclosed.
+fn k_w() -> Option<Mp> {
+    let s3 = Mp::int(3).sqrt();
+    let g = |z: Mp| -> Option<Mp> {
+        let e = z.sqr().ldexp(-1).neg().exp()?;
+        z.sub(&z.sqr().mul(&z)).mul(&e).div(mp::sqrt_2pi())
+    };
+    let z1 = Mp::int(2).sub(&s3).sqrt();
+    let z2 = Mp::int(2).add(&s3).sqrt();
+    Some(g(z1)?.sub(&g(z2)?).ldexp(2))
 }
 
 /// The parabola s·x·a − x²·b at the exact step x.
