@@ -86,8 +86,7 @@ fn meta(id: &str, statement: &str, claim: &str, kind: ClaimKind) -> CheckMeta {
     CheckMeta {
         id: id.into(),
         statement: statement.into(),
-        location: "Section 4.2.2, Definition 4.3 eq. (4.6) and Theorem 4.1; proof in Appendix A, \
-                   thesis lines 874 and 1517"
+        location: "Section 4.2.2, Definition 4.3 eq. (4.6) and Theorem 4.1; proof in Appendix A"
             .into(),
         claim: claim.into(),
         ground_truth: "the budget maintained by sepg_bounds::budget::Budget against the \

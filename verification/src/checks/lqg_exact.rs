@@ -607,7 +607,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t310 = meta(
         "thm-3.10-cor-3.11-adaptive-step",
         "Theorem 3.10 and Corollary 3.11 (Pirotta et al.'s adaptive step)",
-        "Section 3.4, thesis lines 634–650",
+        "Section 3.4",
         "J(θ + α∇J) − J(θ) ≥ α‖∇J‖₂² − α²c‖∇J‖₁² for α ∈ {α*, drawn in [0, 2α*]}, and at \
          α* = ‖∇‖₂²/(2c‖∇‖₁²) the improvement is ≥ α*‖∇J‖₂²/2 (sepg_bounds::pirotta).",
     );
@@ -617,7 +617,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t314 = meta(
         "thm-3.14-diagonal-step",
         "Theorem 3.14 (Papini et al.'s non-scalar step)",
-        "Section 3.5, thesis lines 692–700",
+        "Section 3.5",
         "J(θ + Λ∇J) − J(θ) ≥ ∇JᵀΛ∇J − c‖Λ∇J‖₁² for Λ = α_k (greedy coordinate, α_k = 1/(2c)) \
          and drawn α ∈ [0, 1/c], and the greedy step gains ≥ ‖∇J‖∞²/(4c) (sepg_bounds::papini).",
     );
@@ -625,7 +625,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t42 = meta(
         "thm-4.2-v-update",
         "Theorem 4.2, eqs. (4.8)–(4.10) (v-update with fixed σ)",
-        "Section 4.3.1, thesis lines 940–955",
+        "Section 4.3.1",
         "For α in the safe interval of (4.10) for C (its vertex α* = 1/(2c), both ends — the \
          largest ᾱ = (1 + λ_v)α* — and a drawn step): J(v + α∇_vJ, w) − J(v, w) ≥ (4.8) and ≥ C.",
     );
@@ -636,7 +636,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t42c = meta(
         "thm-4.2-closed-form",
         "Theorem 4.2 implementation vs the printed (4.8)–(4.10)",
-        "Section 4.3.1, thesis lines 940–955",
+        "Section 4.3.1",
         "sepg_bounds::v_update::{bound, safe_step} equal (4.8), α* = 1/(2c), C_max^v = \
          ‖∇‖∞²/(4c) and ᾱ = (1 + λ_v)α* with c recomputed from its printed definition.",
     );
@@ -656,7 +656,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t43 = meta(
         "thm-4.3-w-update-thesis",
         "Theorem 4.3, eqs. (4.15)–(4.17), thesis form (o(Δw³) neglected)",
-        "Section 4.3.2, thesis lines 986–1000; Appendix A",
+        "Section 4.3.2; Appendix A",
         "For β in the safe interval (4.17) (vertex β* = 1/(2d), both ends, a drawn step): \
          J(v, w + β∇_wJ) − J(v, w) ≥ β∇_wJ² − β²d∇_wJ² and ≥ C.",
     );
@@ -704,7 +704,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut gl = meta(
         "app-b-surrogate-gradient",
         "Appendix B (B.1) and ∂_σ∇_vJ = h − (2/σ)∇_vJ: the exact ∇_w L",
-        "Appendix B, thesis lines 1721–1750; docs/CONVENTIONS.md §3",
+        "Appendix B; docs/CONVENTIONS.md §3",
         "sepg_bounds::surrogate::grad_w with the exact mixed derivative ∂_σ∇_vJ equals \
          d/dw [‖∇_vJ(v, w)‖²/(4m c(e^w))].",
     );
@@ -731,7 +731,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t45 = meta(
         "thm-4.5-w-update-along-l",
         "Theorem 4.5 and (4.19), thesis form and rigorous variant",
-        "Section 4.3.3, thesis lines 1034–1050",
+        "Section 4.3.3",
         "For β in the safe interval (4.19) around β̃ = ∇_wJ/(2d∇_wL) (vertex, both ends — the \
          largest β̄ = β̃ + λ_w|β̃| — and a drawn step): J(v, w + β∇_wL) − J(v, w) ≥ \
          β∇_wL∇_wJ − β²d∇_wL² and ≥ νC; the same with the rigorous interval and bound.",

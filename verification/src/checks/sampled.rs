@@ -987,7 +987,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut a46 = meta(
         "assumption-4.6-t-coverage",
         "Assumption 4.6 with the t-based widths of Section 4.5",
-        "Section 4.5, eq. (4.22) and the t-interval, thesis lines 1276–1292",
+        "Section 4.5, eq. (4.22) and the t-interval",
         "P(|∇̂_i − ∇_i| > ε_i) ≤ δ with ε_i = t(1−δ/2, N−1)·√(Var̂/N), for ∇_v J and ∇_w J.",
         "exact gradients of the clipped presets (DP oracle)",
     );
@@ -1013,7 +1013,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut a46g = meta(
         "assumption-4.6-t-coverage-gaussian",
         "Assumption 4.6 with the t-based widths of Section 4.5, on Gaussian samples",
-        "Section 4.5, eq. (4.22) and the t-interval, thesis lines 1276–1292",
+        "Section 4.5, eq. (4.22) and the t-interval",
         "For Gaussian per-trajectory samples, P(|x̄ − μ| > ε) = δ exactly with \
          ε = t(1−δ/2, N−1)·√(Var̂/N) (sepg_estimators::width, Width::StudentT).",
         "Student's theorem: (x̄ − μ)/√(Var̂/N) has the t distribution with N − 1 degrees of freedom",
@@ -1035,7 +1035,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t47 = meta(
         "thm-4.7-hp-v-update",
         "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, docs/CONVENTIONS.md §4 vertex)",
-        "Section 4.5, thesis lines 1300–1314",
+        "Section 4.5",
         "With the estimated gradient and ε, the v-step at the vertex (C = C_max) and the largest \
          step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)^m (m = 1).",
         DP_TRUTH,
@@ -1045,7 +1045,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t48 = meta(
         "thm-4.8-hp-w-update",
         "Theorem 4.8, eqs. (4.27)–(4.29)",
-        "Section 4.5, thesis lines 1316–1328",
+        "Section 4.5",
         "The w-step along ∇̂_wJ at the vertex (C = C_max) and the largest step for C = 0 realise \
          J(θ′) − J(θ) ≥ C except with probability ≤ δ.",
         DP_TRUTH,
@@ -1055,7 +1055,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t49 = meta(
         "thm-4.9-hp-w-along-l",
         "Theorem 4.9, eq. (4.30)",
-        "Section 4.5, thesis lines 1330–1344",
+        "Section 4.5",
         "The w-step along ∇̂_wL (cross-fitted estimator of sepg-estimators) at the vertex and the \
          largest step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)².",
         DP_TRUTH,
@@ -1065,7 +1065,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut neg_p = meta(
         "thm-4.7-4.9-negative-c-printed",
         "Theorems 4.7–4.9 for C < 0, intervals (4.26), (4.29), (4.30) as printed",
-        "Section 4.5, thesis lines 1300–1344",
+        "Section 4.5",
         "For a bounded worsening C = −C_max/10 the end of the printed interval on the side \
          opposite to the estimated direction realises J(θ′) − J(θ) ≥ C except with probability \
          ≤ 1 − (1 − δ)^m.",
@@ -1090,7 +1090,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut t312 = meta(
         "thm-3.12-hp-adaptive-step",
         "Theorem 3.12 (high-probability adaptive step, vertex form)",
-        "Section 3.4.1, thesis lines 660–672",
+        "Section 3.4.1",
         "With per-component t-widths, the step α* maximising the printed bound (vertex, \
          sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
          probability ≤ 1 − (1 − δ)^m (m = 1).",
