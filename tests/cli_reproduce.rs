@@ -144,6 +144,77 @@ fn figures_and_plots_are_png_and_svg() {
     );
 }
 
+/// `sepg reproduce fig-5.1` on `lqg1d` with two seeds of 5 iterations into `d`, with
+/// `extra` flags.
+fn reproduce_two_seeds(d: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "reproduce",
+        "fig-5.1",
+        "--preset",
+        "lqg1d",
+        "--seeds",
+        "2",
+        "--iterations",
+        "5",
+        "--quiet",
+        "--out",
+        d,
+    ];
+    args.extend_from_slice(extra);
+    sepg(&args)
+}
+
+#[test]
+fn reproduce_draws_the_band_asked_for_and_warns_below_three_seeds() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("f");
+    let d = dir.to_str().expect("utf-8");
+    let svg = || std::fs::read_to_string(dir.join("fig-5.1-lqg1d.svg")).expect("svg");
+    // Bands are filled polygons; the legend and the curves are paths and polylines.
+    let bands = |svg: &str| svg.matches("<polygon").count();
+
+    let se = reproduce_two_seeds(d, &["--band", "se"]);
+    assert!(
+        se.status.success(),
+        "{}",
+        String::from_utf8_lossy(&se.stderr)
+    );
+    assert!(se.stdout.is_empty());
+    let warned = String::from_utf8_lossy(&se.stderr);
+    assert!(
+        warned.starts_with("warning: ")
+            && warned.contains("2 seed(s)")
+            && warned.contains("--band none"),
+        "{warned}"
+    );
+    let text = svg();
+    assert!(text.contains("mean ± one standard error across seeds"));
+    // Three panels (J, σ, v), two variants each.
+    assert_eq!(bands(&text), 6);
+
+    let none = reproduce_two_seeds(d, &["--band", "none", "--force"]);
+    assert!(none.status.success() && none.stderr.is_empty());
+    let text = svg();
+    assert!(text.contains("mean across seeds") && bands(&text) == 0);
+
+    let ci = reproduce_two_seeds(d, &["--force"]);
+    assert!(String::from_utf8_lossy(&ci.stderr).contains("warning: "));
+    let text = svg();
+    assert!(text.contains("mean and 95% t-interval across seeds") && bands(&text) == 6);
+
+    let other = tmp.path().join("t");
+    let line = assert_usage_error(&sepg(&[
+        "reproduce",
+        "table-5.1",
+        "--band",
+        "se",
+        "--out",
+        other.to_str().expect("utf-8"),
+    ]));
+    assert!(line.contains("--band"), "{line}");
+    assert!(!other.exists());
+}
+
 #[test]
 fn bad_reproduce_and_plot_input_is_rejected() {
     let tmp = tempfile::tempdir().expect("tempdir");

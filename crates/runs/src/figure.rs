@@ -262,15 +262,43 @@ fn range(panel: &Panel) -> (f64, f64, f64, f64) {
     (x0, x1, y0 - pad, y1 + pad)
 }
 
-fn tick(v: &f64) -> String {
+/// The label of tick value `v` on an axis spanning `span`: a value within 10⁻⁹·span of 0 is
+/// round-off of the tick arithmetic and reads `0`; others get the digits that tell ticks a
+/// tenth of the span apart, as a plain decimal for 10⁻³ ≤ |v| < 10⁵ and in scientific
+/// notation otherwise, without trailing zeros.
+fn tick(v: f64, span: f64) -> String {
     let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{v:.1e}")
+    let span = if span.is_finite() && span > 0.0 {
+        span
     } else {
-        format!("{v:.4}")
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_owned()
+        a.max(1.0)
+    };
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if a <= 1e-9 * span {
+        return "0".to_owned();
+    }
+    let resolution = (span / 10.0).log10().floor();
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (-resolution).clamp(0.0, 12.0) as usize;
+        trim_zeros(&format!("{v:.decimals$}")).to_owned()
+    } else {
+        let digits = (a.log10().floor() - resolution).clamp(1.0, 12.0) as usize;
+        let s = format!("{v:.digits$e}");
+        match s.split_once('e') {
+            Some((mantissa, exponent)) => format!("{}e{exponent}", trim_zeros(mantissa)),
+            None => s,
+        }
+    }
+}
+
+/// `s` without the trailing zeros of its fractional part (and without a bare point).
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
     }
 }
 
@@ -484,8 +512,8 @@ fn draw_panel<DB: DrawingBackend>(
         .axis_desc_style((FAMILY, 13))
         .x_labels(6)
         .y_labels(6)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&|v| tick(*v, x1 - x0))
+        .y_label_formatter(&|v| tick(*v, y1 - y0))
         .light_line_style(WHITE)
         .draw()
         .map_err(e)?;
@@ -744,6 +772,32 @@ mod tests {
                 .and_then(|v| v.parse().ok())
                 .expect("x attribute");
             assert!(x >= lay.legend_x, "group {g} at x = {x}");
+        }
+    }
+
+    #[test]
+    fn tick_labels_snap_round_off_to_zero_and_keep_ticks_apart() {
+        // The v-panel of a reproduction spanning [-0.7, 0.1] put its 0 tick at -1.1e-16.
+        assert_eq!(tick(-1.1e-16, 0.8), "0");
+        assert_eq!(tick(2.2e-17, 5e3), "0");
+        assert_eq!(tick(0.0, 0.8), "0");
+        assert_eq!(tick(-0.6, 0.8), "-0.6");
+        assert_eq!(tick(-0.25, 0.8), "-0.25");
+        assert_eq!(tick(1500.0, 4000.0), "1500");
+        // A tiny value on a tiny axis is a real tick, shown in scientific notation.
+        assert_eq!(tick(2.5e-5, 1e-4), "2.5e-5");
+        assert_eq!(tick(3e-4, 1e-3), "3e-4");
+        assert_eq!(tick(-1.5e5, 1e5), "-1.5e5");
+        // Ticks a tenth of the span apart never share a label, on axes of any size.
+        for span in [1e-7, 3e-4, 0.02, 0.8, 7.0, 3e3, 2e6] {
+            let start = -span * 0.37;
+            let step = span / 10.0;
+            let labels: Vec<String> = (0..=10)
+                .map(|k| tick(start + step * f64::from(k), span))
+                .collect();
+            for (i, a) in labels.iter().enumerate() {
+                assert!(!labels[..i].contains(a), "{span}: {labels:?}");
+            }
         }
     }
 

@@ -152,14 +152,13 @@ fn table(file: &SweepFile, runs: &[Loaded], delta: f64, setting: Setting) -> (St
 }
 
 /// Curves of `column` (x = iteration or trajectories) for every run of (preset, variant)
-/// at σ⁰, as mean and band across seeds.
+/// at σ⁰, as mean and band of kind `band` across seeds.
 fn series(
     runs: &[Loaded],
-    preset: EnvName,
-    variant: &str,
-    sigma0: f64,
+    (preset, variant, sigma0): (EnvName, &str, f64),
     x_col: &str,
     y: &dyn Fn(&Log) -> Option<Vec<f64>>,
+    band: BandKind,
 ) -> Option<Series> {
     let group: Vec<&Loaded> = runs
         .iter()
@@ -167,7 +166,7 @@ fn series(
         .collect();
     let curves: Vec<Vec<f64>> = group.iter().filter_map(|r| y(&r.log)).collect();
     let x = group.first()?.log.column(x_col)?;
-    let (mean, band) = mean_band(&curves, BandKind::Ci95);
+    let (mean, band) = mean_band(&curves, band);
     let x = x[..mean.len().min(x.len())].to_vec();
     Some(Series {
         label: display_name(variant),
@@ -206,6 +205,7 @@ struct PanelMaker<'a> {
     preset: EnvName,
     sigma0: f64,
     x_col: &'static str,
+    band: BandKind,
 }
 
 impl PanelMaker<'_> {
@@ -218,7 +218,10 @@ impl PanelMaker<'_> {
             series: self
                 .names
                 .iter()
-                .filter_map(|n| series(self.runs, self.preset, n, self.sigma0, self.x_col, y))
+                .filter_map(|n| {
+                    let group = (self.preset, n.as_str(), self.sigma0);
+                    series(self.runs, group, self.x_col, y, self.band)
+                })
                 .collect(),
             hlines: Vec::new(),
         }
@@ -338,12 +341,14 @@ pub fn display_name(variant: &str) -> String {
     variant.to_owned()
 }
 
-/// The figures of experiment `what` (one per preset) with their file stems.
+/// The figures of experiment `what` (one per preset), with bands of kind `band`, and their
+/// file stems.
 fn figures(
     what: Experiment,
     file: &SweepFile,
     runs: &[Loaded],
     delta: f64,
+    band: BandKind,
 ) -> Vec<(String, Figure)> {
     let sigma0 = file.spec.sigma0[0];
     let names: Vec<String> = file
@@ -365,6 +370,7 @@ fn figures(
             preset,
             sigma0,
             x_col,
+            band,
         };
         let panels = maker.panels(what);
         let seeds = seed_count(&file.spec.seeds);
@@ -372,7 +378,7 @@ fn figures(
             "{} — {}, σ⁰ = {sigma0}, {seeds} seeds, δ = {delta} ({})",
             what.name(),
             preset.name(),
-            BandKind::Ci95.describe(),
+            band.describe(),
         );
         let columns = grid_columns(panels.len());
         let stem = if what == Experiment::Fig54 {
@@ -405,15 +411,34 @@ pub enum Outputs {
     Figures {
         /// The files written, in order.
         paths: Vec<PathBuf>,
+        /// Warnings for the reader (bands over fewer than [`MIN_BAND_SEEDS`] seeds).
+        warnings: Vec<String>,
     },
 }
 
+/// The warning for bands of kind `band` drawn over as few as `fewest` seeds, if any: below
+/// [`MIN_BAND_SEEDS`] seeds a band rests on too few degrees of freedom to say much.
+fn band_warning(band: BandKind, fewest: usize) -> Option<String> {
+    (band != BandKind::None && fewest < MIN_BAND_SEEDS).then(|| {
+        format!(
+            "a group has only {fewest} seed(s): its band rests on {} degree(s) of freedom \
+             and says little; use {MIN_BAND_SEEDS} seeds or more, or --band none",
+            fewest.saturating_sub(1)
+        )
+    })
+}
+
 /// Writes the table or figures of the finished reproduction in `dir` (whose `sweep.json` is
-/// `file`, run with `opts`).
+/// `file`, run with `opts`); the figures' bands are of kind `band`.
 ///
 /// # Errors
 /// [`Error::Failed`] when a run cannot be read or a file cannot be written or drawn.
-pub fn write_outputs(opts: &ReproduceOptions, dir: &Path, file: &SweepFile) -> Result<Outputs> {
+pub fn write_outputs(
+    opts: &ReproduceOptions,
+    dir: &Path,
+    file: &SweepFile,
+    band: BandKind,
+) -> Result<Outputs> {
     let runs = load(dir, file)?;
     if opts.what == Experiment::Table51 {
         let (markdown, csv) = table(file, &runs, opts.delta, opts.setting);
@@ -422,10 +447,12 @@ pub fn write_outputs(opts: &ReproduceOptions, dir: &Path, file: &SweepFile) -> R
         return Ok(Outputs::Table { markdown });
     }
     let mut paths = Vec::new();
-    for (stem, fig) in figures(opts.what, file, &runs, opts.delta) {
+    for (stem, fig) in figures(opts.what, file, &runs, opts.delta, band) {
         paths.extend(figure::save_both(&fig, dir, &stem)?);
     }
-    Ok(Outputs::Figures { paths })
+    let fewest = usize::try_from(seed_count(&file.spec.seeds)).unwrap_or(usize::MAX);
+    let warnings = band_warning(band, fewest).into_iter().collect();
+    Ok(Outputs::Figures { paths, warnings })
 }
 
 /// The (column, panel title, axis label) of the four panels.
@@ -602,13 +629,7 @@ pub fn plot(dir: &Path, out: Option<&Path>, band: BandKind) -> Result<Plotted> {
     let mut warnings = Vec::new();
     let fig = if dir.join(SWEEP_FILE).is_file() {
         let (fig, fewest) = sweep_figure(dir, &SweepFile::read(dir)?, band)?;
-        if band != BandKind::None && fewest < MIN_BAND_SEEDS {
-            warnings.push(format!(
-                "a group has only {fewest} seed(s): its band rests on {} degree(s) of freedom \
-                 and says little; use {MIN_BAND_SEEDS} seeds or more, or --band none",
-                fewest.saturating_sub(1)
-            ));
-        }
+        warnings.extend(band_warning(band, fewest));
         fig
     } else if dir.join(CONFIG_FILE).is_file() {
         one_run(dir)?
@@ -651,5 +672,87 @@ mod tests {
         }
         let b = with_zero_line(Panel::default());
         assert_eq!(b.hlines, vec![("B = 0".to_owned(), 0.0)]);
+    }
+
+    /// Mean and sample standard deviation of `ys`, computed here from the definitions.
+    fn mean_sd(ys: &[f64]) -> (f64, f64) {
+        let k = ys.len() as f64;
+        let m = ys.iter().sum::<f64>() / k;
+        let ss = ys.iter().map(|y| (y - m).powi(2)).sum::<f64>();
+        (m, (ss / (k - 1.0)).sqrt())
+    }
+
+    /// Figures 5.1 of a three-seed reproduction drawn with each kind of band: every point of
+    /// every band is m ± t(0.975, 2)·s/√3 (ci95) or m ± s/√3 (se) of the three runs' logged
+    /// values, the σ band clipped at 0; `none` draws no band. t(0.975, 2) = 0.95/√(2·0.975·
+    /// 0.025) in closed form. Cost: 2 variants × 3 seeds × 8 iterations on `lqg1d`.
+    #[test]
+    fn reproduced_figures_draw_the_band_asked_for() {
+        use crate::reproduce::{LqgPreset, Mode};
+        use crate::run::Silent;
+        use crate::sweep::SweepOptions;
+        use std::sync::atomic::AtomicBool;
+
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let dir = tmp.path().join("fig");
+        let opts = ReproduceOptions {
+            preset: Some(LqgPreset::Lqg1d),
+            seeds: 3,
+            iterations: Some(8),
+            ..ReproduceOptions::new(Experiment::Fig51)
+        };
+        let stop = AtomicBool::new(false);
+        let sweep_opts = SweepOptions {
+            checkpoint_every: 100,
+            stop: &stop,
+            observer: &Silent,
+        };
+        let (file, _) =
+            crate::reproduce::run(&opts, &dir, Mode::Start { force: false }, sweep_opts)
+                .expect("reproduction runs");
+        let runs = load(&dir, &file).expect("runs load");
+        let t2 = 0.95 / (2.0 * 0.975 * 0.025f64).sqrt();
+        for (band, factor) in [
+            (BandKind::Ci95, Some(t2)),
+            (BandKind::Se, Some(1.0)),
+            (BandKind::None, None),
+        ] {
+            let figs = figures(Experiment::Fig51, &file, &runs, opts.delta, band);
+            assert_eq!(figs.len(), 1);
+            let fig = &figs[0].1;
+            assert!(fig.title.contains(band.describe()), "{}", fig.title);
+            for (panel, column, floor) in [
+                (&fig.panels[0], "j_explore", f64::NEG_INFINITY),
+                (&fig.panels[1], "sigma", 0.0),
+                (&fig.panels[2], "v", f64::NEG_INFINITY),
+            ] {
+                assert_eq!(panel.series.len(), 2, "{}", panel.title);
+                for s in &panel.series {
+                    let logs: Vec<Vec<f64>> = runs
+                        .iter()
+                        .filter(|r| display_name(&r.variant) == s.label)
+                        .map(|r| r.log.column(column).expect("column"))
+                        .collect();
+                    assert_eq!(logs.len(), 3, "{}", s.label);
+                    let Some(factor) = factor else {
+                        assert_eq!(s.band, None);
+                        continue;
+                    };
+                    let (lo, hi) = s.band.as_ref().expect("band");
+                    assert_eq!(s.mean.len(), 8);
+                    for i in 0..8 {
+                        let (m, sd) = mean_sd(&[logs[0][i], logs[1][i], logs[2][i]]);
+                        let h = factor * sd / 3f64.sqrt();
+                        let tol = 1e-12 * (m.abs() + h).max(1e-300);
+                        assert!((s.mean[i] - m).abs() <= tol, "{column} {i}");
+                        assert!((hi[i] - (m + h)).abs() <= tol, "{column} {i}");
+                        assert!((lo[i] - (m - h).max(floor)).abs() <= tol, "{column} {i}");
+                    }
+                }
+            }
+        }
+        assert!(band_warning(BandKind::Ci95, 3).is_none());
+        assert!(band_warning(BandKind::Se, 2).is_some_and(|w| w.contains("2 seed(s)")));
+        assert!(band_warning(BandKind::None, 1).is_none());
     }
 }
