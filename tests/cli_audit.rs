@@ -7,7 +7,7 @@
 use std::fs;
 use std::path::Path;
 
-use crate::common::{assert_usage_error, sepg};
+use crate::common::{assert_usage_error, readme_run, sepg, sepg_ok};
 
 fn path(dir: &Path) -> &str {
     dir.to_str().expect("utf-8 path")
@@ -17,13 +17,7 @@ fn path(dir: &Path) -> &str {
 fn run(dir: &Path, args: &[&str]) {
     let mut all = vec!["run", "--quiet", "--out", path(dir)];
     all.extend_from_slice(args);
-    let out = sepg(&all);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    sepg_ok(&all);
 }
 
 /// A short exact run of `algo` on the `lqg` preset (clipped: audited with the DP oracle).
@@ -41,35 +35,6 @@ fn exact_run(dir: &Path, algo: &str) {
             "0.5",
             "--iterations",
             "12",
-        ],
-    );
-}
-
-/// A sampled SEPG-ZV run on `lqg1d`: the README's example, shortened to 300 iterations.
-fn sampled_run(dir: &Path) {
-    run(
-        dir,
-        &[
-            "--env",
-            "lqg1d",
-            "--algo",
-            "sepg-zv",
-            "--gradients",
-            "sampled",
-            "--v0",
-            "-0.1",
-            "--sigma0",
-            "1.0",
-            "--iterations",
-            "300",
-            "--batch",
-            "100",
-            "--horizon",
-            "20",
-            "--delta",
-            "0.2",
-            "--seed",
-            "1",
         ],
     );
 }
@@ -279,7 +244,8 @@ fn each_exact_check_fails_when_its_own_requirement_is_broken() {
 fn a_sampled_run_is_judged_by_the_binomial_test() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("zv");
-    sampled_run(&dir);
+    // The README's example, shortened to 300 iterations.
+    sepg_ok(&readme_run(&dir, 300));
     let (code, report) = audit_json(&dir);
     assert_eq!(code, Some(0), "{report}");
     assert_eq!(report["status"], "holds");

@@ -8,51 +8,7 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-use crate::common::{assert_usage_error, sepg};
-
-/// The form of the issue, which scripts depend on, with fewer iterations.
-fn issue_form(out: &Path, iterations: &str) -> Vec<String> {
-    [
-        "run",
-        "--env",
-        "lqg1d",
-        "--algo",
-        "sepg-zv",
-        "--gradients",
-        "sampled",
-        "--v0",
-        "-0.1",
-        "--sigma0",
-        "1.0",
-        "--iterations",
-        iterations,
-        "--batch",
-        "100",
-        "--horizon",
-        "20",
-        "--delta",
-        "0.2",
-        "--seed",
-        "1",
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([out.display().to_string()])
-    .collect()
-}
-
-fn run_ok(args: &[String]) {
-    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = sepg(&refs);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
+use crate::common::{assert_usage_error, readme_run, sepg, sepg_ok};
 
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
@@ -69,10 +25,10 @@ fn v_star() -> f64 {
 }
 
 #[test]
-fn the_issue_form_writes_a_complete_run_folder() {
+fn the_readme_example_writes_a_complete_run_folder() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("run");
-    run_ok(&issue_form(&dir, "30"));
+    sepg_ok(&readme_run(&dir, 30));
     for f in ["config.toml", "log.csv", "summary.json", "checkpoint.json"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
@@ -171,7 +127,7 @@ fn flags_override_the_config_file_and_multi_dimensional_columns_are_indexed() {
     .map(|s| s.to_string())
     .chain([dir.display().to_string()])
     .collect();
-    run_ok(&args);
+    sepg_ok(&args);
     let config = read(&dir.join("config.toml"));
     assert!(
         config.contains("iterations = 2") && config.contains("seed = 5"),
@@ -247,12 +203,12 @@ fn resume(dir: &Path) {
 #[test]
 fn resuming_after_sigkill_at_random_points_is_bit_identical() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let iterations = "1500";
+    let iterations = 1500;
     let reference = tmp.path().join("reference");
     let start = Instant::now();
-    run_ok(
+    sepg_ok(
         &[
-            issue_form(&reference, iterations),
+            readme_run(&reference, iterations),
             vec!["--checkpoint-every".into(), "37".into()],
         ]
         .concat(),
@@ -265,7 +221,7 @@ fn resuming_after_sigkill_at_random_points_is_bit_identical() {
     for attempt in 0..6 {
         let dir = tmp.path().join(format!("killed-{attempt}"));
         let args = [
-            issue_form(&dir, iterations),
+            readme_run(&dir, iterations),
             vec!["--checkpoint-every".into(), "37".into()],
         ]
         .concat();
@@ -313,11 +269,11 @@ fn signal_checkpoints_and_resumes_bit_identically(signal: &str) {
     let tmp = tempfile::tempdir().expect("tempdir");
     let reference = tmp.path().join("reference");
     let start = Instant::now();
-    run_ok(&issue_form(&reference, "1500"));
+    sepg_ok(&readme_run(&reference, 1500));
     let full = start.elapsed();
     let dir = tmp.path().join("interrupted");
     let child = Command::new(env!("CARGO_BIN_EXE_sepg"))
-        .args(issue_form(&dir, "1500"))
+        .args(readme_run(&dir, 1500))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -400,7 +356,7 @@ fn logs_are_byte_identical_with_one_and_two_threads() {
 fn resuming_a_complete_run_changes_nothing() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("done");
-    run_ok(&issue_form(&dir, "5"));
+    sepg_ok(&readme_run(&dir, 5));
     let before = std::fs::read(dir.join("summary.json")).expect("summary");
     resume(&dir);
     assert_eq!(

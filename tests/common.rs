@@ -1,13 +1,73 @@
 //! Helpers shared by the command-line tests.
 
+use std::ffi::OsStr;
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs the `sepg` binary with `args` and returns its output.
 pub fn sepg(args: &[&str]) -> Output {
+    sepg_os(args)
+}
+
+/// Runs the `sepg` binary with `args` (strings or paths) and returns its output.
+fn sepg_os<S: AsRef<OsStr>>(args: &[S]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sepg"))
         .args(args)
         .output()
         .expect("the sepg binary runs")
+}
+
+/// Runs the `sepg` binary with `args`, asserting exit status 0; returns its output.
+pub fn sepg_ok<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    let out = sepg_os(args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "sepg {:?}: {}",
+        args.iter().map(AsRef::as_ref).collect::<Vec<_>>(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The arguments of the README's example run, shortened to `iterations` iterations and
+/// quiet, into the run folder `out`:
+///
+/// ```text
+/// sepg run --env lqg1d --algo sepg-zv --gradients sampled --v0 -0.1 --sigma0 1.0 \
+///   --iterations N --batch 100 --horizon 20 --delta 0.2 --seed 1 --quiet --out DIR
+/// ```
+pub fn readme_run(out: &Path, iterations: u64) -> Vec<String> {
+    let iterations = iterations.to_string();
+    [
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-zv",
+        "--gradients",
+        "sampled",
+        "--v0",
+        "-0.1",
+        "--sigma0",
+        "1.0",
+        "--iterations",
+        &iterations,
+        "--batch",
+        "100",
+        "--horizon",
+        "20",
+        "--delta",
+        "0.2",
+        "--seed",
+        "1",
+        "--quiet",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([out.display().to_string()])
+    .collect()
 }
 
 /// Asserts the contract for bad input: exit status 2, nothing on standard output, exactly
