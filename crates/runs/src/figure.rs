@@ -435,7 +435,21 @@ fn layout(fig: &Figure) -> Layout {
     }
 }
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
+/// How curves are stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pen {
+    /// One polyline of width 2 (SVG: the viewer joins the segments).
+    Stroke,
+    /// Three polylines of width 1, offset by a pixel right and up (bitmaps: plotters fills a
+    /// wider polyline as one polygon whose joins at sharp turns spike far beyond the data).
+    Pixels,
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &Figure,
+    pen: Pen,
+) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let lay = layout(fig);
     root.fill(&WHITE).map_err(e)?;
@@ -445,7 +459,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     let entries = legend(fig);
     let cells = panels_area.split_evenly((lay.rows as usize, lay.columns as usize));
     for (cell, panel) in cells.iter().zip(shown(fig)) {
-        draw_panel(cell, panel, &entries)?;
+        draw_panel(cell, panel, &entries, pen)?;
     }
     draw_legend(&legend_area, &entries)?;
     root.present().map_err(e)
@@ -494,6 +508,7 @@ fn draw_panel<DB: DrawingBackend>(
     cell: &DrawingArea<DB, Shift>,
     panel: &Panel,
     entries: &[Entry],
+    pen: Pen,
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let (x0, x1, y0, y1) = range(panel);
@@ -532,12 +547,25 @@ fn draw_panel<DB: DrawingBackend>(
                 )))
                 .map_err(e)?;
         }
-        chart
-            .draw_series(LineSeries::new(
-                decimate(&s.x, &s.mean, Pick::Both),
-                colour.stroke_width(2),
-            ))
-            .map_err(e)?;
+        let points = decimate(&s.x, &s.mean, Pick::Both);
+        match pen {
+            Pen::Stroke => {
+                chart
+                    .draw_series(LineSeries::new(points, colour.stroke_width(2)))
+                    .map_err(e)?;
+            }
+            Pen::Pixels => {
+                let (w, h) = chart.plotting_area().dim_in_pixel();
+                let dx = (x1 - x0) / f64::from(w.max(1));
+                let dy = (y1 - y0) / f64::from(h.max(1));
+                for (ox, oy) in [(0.0, 0.0), (dx, 0.0), (0.0, dy)] {
+                    let shifted = points.iter().map(|&(x, y)| (x + ox, y + oy));
+                    chart
+                        .draw_series(LineSeries::new(shifted, colour.stroke_width(1)))
+                        .map_err(e)?;
+                }
+            }
+        }
     }
     for (_, y) in &panel.hlines {
         chart
@@ -570,7 +598,7 @@ pub fn save(fig: &Figure, path: &Path) -> Result<()> {
             let mut svg = String::new();
             {
                 let root = SVGBackend::with_string(&mut svg, size(fig)).into_drawing_area();
-                draw(&root, fig).map_err(fail)?;
+                draw(&root, fig, Pen::Stroke).map_err(fail)?;
             }
             write_atomic(path, svg.as_bytes())
         }
@@ -586,7 +614,7 @@ pub fn save(fig: &Figure, path: &Path) -> Result<()> {
                 .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
             {
                 let root = BitMapBackend::new(tmp.path(), size(fig)).into_drawing_area();
-                draw(&root, fig).map_err(fail)?;
+                draw(&root, fig, Pen::Pixels).map_err(fail)?;
             }
             tmp.persist(path).map_err(|e| {
                 Error::failed(format!("cannot write {}: {}", path.display(), e.error))
@@ -799,6 +827,72 @@ mod tests {
                 assert!(!labels[..i].contains(a), "{span}: {labels:?}");
             }
         }
+    }
+
+    /// Rows of the RGB image `buf` of width `w` holding a pixel of colour `c` left of
+    /// column `right`.
+    fn rows_with(buf: &[u8], w: usize, right: usize, c: RGBColor) -> Vec<usize> {
+        let mut rows: Vec<usize> = buf
+            .chunks(3)
+            .enumerate()
+            .filter(|(i, px)| i % w < right && px == &[c.0, c.1, c.2])
+            .map(|(i, _)| i / w)
+            .collect();
+        rows.dedup();
+        rows
+    }
+
+    #[test]
+    fn dense_noisy_curves_stay_inside_their_panel_in_png() {
+        // A noisy curve of 10,000 points in [0, 1], like the J of a sampled run: decimated to
+        // sharp zigzags. Drawn with a thick polygonised stroke, the zigzags' joins spiked far
+        // beyond the data, across the axis, its labels and the figure's title. The panel's
+        // plotting area is its 400 px less the caption (about 20 px), the margins (2 × 10 px)
+        // and the x-axis labels (40 px); the curve, with the range padded by 5% on each side,
+        // must fit in it, below the figure's title (22 px text).
+        let n = 10_000;
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+        let mean: Vec<f64> = (0..n)
+            .map(|_| {
+                // xorshift64*, a fixed stream.
+                state ^= state >> 12;
+                state ^= state << 25;
+                state ^= state >> 27;
+                (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+            })
+            .collect();
+        let fig = Figure {
+            title: "noise".into(),
+            panels: vec![Panel {
+                title: "p".into(),
+                series: vec![Series {
+                    label: "noise".into(),
+                    x: (0..n).map(f64::from).collect(),
+                    mean,
+                    band: None,
+                }],
+                ..Panel::default()
+            }],
+            columns: 1,
+        };
+        register_font().expect("font");
+        let (w, h) = size(&fig);
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+            draw(&root, &fig, Pen::Pixels).expect("drawn");
+        }
+        // Left of the legend (whose sample line has the series' colour).
+        let curve = rows_with(&buf, w as usize, layout(&fig).legend_x as usize, PALETTE[0]);
+        let (top, bottom) = (
+            *curve.first().expect("drawn"),
+            *curve.last().expect("drawn"),
+        );
+        assert!(top > 40, "curve reaches row {top}");
+        assert!(
+            bottom - top < (PANEL_H - 80) as usize,
+            "curve spans rows {top}..={bottom} of {h}"
+        );
     }
 
     #[test]
