@@ -274,6 +274,15 @@ fn an_interrupted_sweep_resumes_to_the_same_logs() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert_eq!(logs(&dir), logs(&reference));
+    // Resuming the completed sweep runs nothing, and says so rather than report a speed.
+    let d = dir.to_str().expect("utf-8");
+    let again = sepg(&["sweep", "--resume", d]);
+    assert_eq!(again.status.code(), Some(0));
+    let line = String::from_utf8(again.stdout).expect("utf-8");
+    assert_eq!(
+        line.trim(),
+        format!("{d}: no run left to run ({} complete)", runs.len())
+    );
 }
 
 #[test]

@@ -52,15 +52,23 @@ pub fn stats_line(dir: &Path, file: &SweepFile, s: &SweepStats) -> String {
     } else {
         String::new()
     };
+    if s.runs == 0 {
+        return format!(
+            "{}{shard}: no run left to run ({} complete)",
+            dir.display(),
+            file.shard_runs().count()
+        );
+    }
     let rate = if s.wall_s > 0.0 {
         s.iterations as f64 / s.wall_s
     } else {
         0.0
     };
     format!(
-        "{}{shard}: {} runs, {} iterations in {:.1} s ({:.0} it/s)",
+        "{}{shard}: {} run{}, {} iterations in {:.1} s ({:.0} it/s)",
         dir.display(),
         s.runs,
+        if s.runs == 1 { "" } else { "s" },
         s.iterations,
         s.wall_s,
         rate
