@@ -111,6 +111,7 @@ fn a_clean_exact_run_passes_and_an_injected_drop_is_reported_at_its_iteration() 
     let (code, report) = audit_json(&dir);
     assert_eq!(code, Some(0), "{report}");
     assert_eq!(report["status"], "holds");
+    assert_eq!(report["algorithm"], "sepg-mi");
     assert_eq!(report["rows"], 12);
     assert_eq!(report["skipped"], 0);
     // Every iteration checks its v-guarantee and monotonic improvement, listed although they

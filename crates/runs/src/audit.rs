@@ -61,6 +61,7 @@ use crate::folder::{
     CHECKPOINT_FILE, Checkpoint, LOG_FILE, PARTIAL_LOG_FILE, SUMMARY_FILE, Summary, load_resolved,
     log_header,
 };
+use crate::spec::{AlgoName, RunSpec};
 
 /// Family-wise significance level of the binomial tests of a sampled run, unless the caller
 /// asks for another one.
@@ -610,6 +611,20 @@ impl ExactJ {
     }
 }
 
+/// The algorithm of `spec` under its configuration name (`sepg-zv`), with the requirement of
+/// `sepg-naive-w` (`sepg-naive-w, requirement zv`).
+fn algorithm_name(spec: &RunSpec) -> String {
+    let algo = spec.algo.map_or("unknown", AlgoName::name);
+    let requirement = spec
+        .requirement
+        .and_then(|r| serde_json::to_value(r).ok())
+        .and_then(|v| v.as_str().map(str::to_owned));
+    match requirement {
+        Some(r) => format!("{algo}, requirement {r}"),
+        None => algo.to_owned(),
+    }
+}
+
 /// J values of the audit: exact when an oracle exists, else the logged estimates.
 enum Source {
     Exact(ExactJ),
@@ -691,7 +706,7 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
     };
     Ok(AuditReport {
         dir: dir.display().to_string(),
-        algorithm: format!("{:?}", config.algorithm),
+        algorithm: algorithm_name(&resolved.spec),
         gradients,
         source: source_name,
         alpha,
