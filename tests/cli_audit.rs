@@ -102,6 +102,106 @@ fn violated(report: &serde_json::Value) -> (Vec<String>, Vec<u64>) {
     (names, its)
 }
 
+/// Whether the printed `cell` shows `value` (a JSON number, or `-` for null) to its printed
+/// precision: a mantissa m.ddd…e±k with D decimals is within half a unit of its last digit,
+/// 0.5·10^(k − D) ≤ 0.5·10^(−D)·|value|.
+fn shows(cell: &str, value: &serde_json::Value) -> bool {
+    match value.as_f64() {
+        None => cell == "-" && value.is_null(),
+        Some(x) => {
+            let printed: f64 = cell.parse().unwrap_or(f64::NAN);
+            let decimals = cell
+                .split('e')
+                .next()
+                .and_then(|m| m.split('.').nth(1))
+                .map_or(0, str::len);
+            let unit = 10f64.powi(-i32::try_from(decimals).expect("short"));
+            (printed - x).abs() <= 0.5001 * unit * x.abs().max(printed.abs())
+        }
+    }
+}
+
+/// Asserts that every number and word of the printed report of `dir` is in its `--json`
+/// report: the header, each check's line and each listed failure.
+fn assert_table_is_in_the_json(dir: &Path) {
+    let (_, report) = audit_json(dir);
+    let out = sepg(&["audit", path(dir)]);
+    let table = String::from_utf8(out.stdout).expect("utf-8");
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next(),
+        Some(format!("audit of {}", path(dir)).as_str())
+    );
+    let field = |line: Option<&str>, key: &str| {
+        line.and_then(|l| l.split_once(':'))
+            .map(|(k, v)| (k.to_owned(), v.trim().to_owned()))
+            .filter(|(k, _)| k == key)
+            .unwrap_or_else(|| panic!("no {key} line in {table}"))
+            .1
+    };
+    assert_eq!(field(lines.next(), "algorithm"), report["algorithm"]);
+    assert_eq!(field(lines.next(), "gradients"), report["gradients"]);
+    assert_eq!(field(lines.next(), "J from"), report["source"]);
+    let counts = format!(
+        "{} of {} iterations done, {} rows, {} skipped (next parameters not logged)",
+        report["iterations_done"], report["iterations_total"], report["rows"], report["skipped"]
+    );
+    assert_eq!(lines.next(), Some(counts.as_str()));
+    assert!(lines.next().is_some_and(|l| l.starts_with("check")));
+    let checks = report["checks"].as_array().expect("checks");
+    for c in checks {
+        let cells: Vec<&str> = lines
+            .next()
+            .expect("check line")
+            .split_whitespace()
+            .collect();
+        assert_eq!(cells.len(), 9, "{cells:?}");
+        assert_eq!(cells[0], c["check"]);
+        let kind = c["kind"].as_str().expect("kind");
+        assert!(kind.starts_with(cells[1]), "{kind} vs {}", cells[1]);
+        assert_eq!(cells[2], c["checked"].to_string());
+        assert_eq!(cells[3], c["failed"].to_string());
+        assert!(shows(cells[4], &c["worst_shortfall"]), "{cells:?} {c}");
+        assert_eq!(cells[5], c["worst_iteration"].to_string());
+        assert!(shows(cells[6], &c["allowed_rate"]), "{cells:?} {c}");
+        assert!(shows(cells[7], &c["p_value"]), "{cells:?} {c}");
+        assert!(
+            c["verdict"]
+                .as_str()
+                .expect("verdict")
+                .eq_ignore_ascii_case(cells[8])
+        );
+    }
+    let failures = report["failures"].as_array().expect("failures");
+    let violated: Vec<&serde_json::Value> = failures
+        .iter()
+        .filter(|f| {
+            checks
+                .iter()
+                .any(|c| c["check"] == f["check"] && c["verdict"] == "violated")
+        })
+        .collect();
+    if !violated.is_empty() {
+        assert!(
+            lines
+                .next()
+                .is_some_and(|l| l.trim_start().starts_with("iteration"))
+        );
+        for f in violated.iter().take(20) {
+            let cells: Vec<&str> = lines
+                .next()
+                .expect("failure line")
+                .split_whitespace()
+                .collect();
+            assert_eq!(cells[0], f["iteration"].to_string());
+            assert_eq!(cells[1], f["check"]);
+            for (cell, key) in cells[2..].iter().zip(["required", "actual", "shortfall"]) {
+                assert!(shows(cell, &f[key]), "{cells:?} {f}");
+            }
+        }
+    }
+}
+
 #[test]
 fn a_clean_exact_run_passes_and_an_injected_drop_is_reported_at_its_iteration() {
     let tmp = tempfile::tempdir().expect("tempdir");
@@ -160,7 +260,9 @@ fn a_clean_exact_run_passes_and_an_injected_drop_is_reported_at_its_iteration() 
     );
     assert_eq!(mi["worst_iteration"], 5);
 
-    // The table lists every check, names the iteration, and the exit status says so.
+    // The table lists every check, names the iteration, and the exit status says so; every
+    // number it shows is in the JSON report.
+    assert_table_is_in_the_json(&dir);
     let out = sepg(&["audit", path(&dir)]);
     assert_eq!(out.status.code(), Some(1));
     let table = String::from_utf8(out.stdout).expect("utf-8");
@@ -275,6 +377,7 @@ fn a_sampled_run_is_judged_by_the_binomial_test() {
     let p = c["p_value"].as_f64().expect("p");
     let expected = 1.0 - 0.8f64.powi(i32::try_from(n).expect("small"));
     assert!((p - expected).abs() <= 1e-12, "{p} vs {expected}");
+    assert_table_is_in_the_json(&dir);
 
     // Every v-step claiming an improvement of 1 that it never delivers: the failure rate 1 is
     // far above δ = 0.2 (p-value 0.2ⁿ), so the test rejects and the run is violated.
@@ -365,13 +468,10 @@ fn every_malformed_or_incomplete_folder_exits_with_status_2() {
     assert_eq!(sepg(&["audit", path(&dir)]).status.code(), Some(0));
 }
 
-#[test]
-fn an_interrupted_run_is_audited_up_to_its_checkpoint_and_reported_incomplete() {
-    let tmp = tempfile::tempdir().expect("tempdir");
-    let dir = tmp.path().join("mi");
-    exact_run(&dir, "sepg-mi");
-    // Turn the finished run into the folder of a run interrupted after 8 iterations: the
-    // first 8 rows in log.partial.csv and a checkpoint saying so (θ⁸ from row 8).
+/// Turns the finished 12-iteration run in `dir` into the folder of a run interrupted after 8
+/// iterations: the first 8 rows (and a torn 9th) in `log.partial.csv`, and a checkpoint
+/// saying so (θ⁸ from row 8). Returns the checkpoint.
+fn interrupt_after_8(dir: &Path) -> serde_json::Value {
     let text = fs::read_to_string(dir.join("log.csv")).expect("log.csv");
     let lines: Vec<&str> = text.lines().collect();
     let prefix = lines[..9].join("\n") + "\n";
@@ -386,6 +486,15 @@ fn an_interrupted_run_is_audited_up_to_its_checkpoint_and_reported_incomplete() 
     fs::write(dir.join("log.partial.csv"), prefix + lines[9] + "\n").expect("write");
     fs::remove_file(dir.join("log.csv")).expect("remove");
     fs::remove_file(dir.join("summary.json")).expect("remove");
+    ck
+}
+
+#[test]
+fn an_interrupted_run_is_audited_up_to_its_checkpoint_and_reported_incomplete() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("mi");
+    exact_run(&dir, "sepg-mi");
+    interrupt_after_8(&dir);
 
     let out = sepg(&["audit", "--json", path(&dir)]);
     assert_eq!(out.status.code(), Some(2));
@@ -399,6 +508,52 @@ fn an_interrupted_run_is_audited_up_to_its_checkpoint_and_reported_incomplete() 
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert!(err.contains("sepg run --resume"), "{err}");
     assert_eq!(err.lines().count(), 1);
+}
+
+#[test]
+fn summaries_and_checkpoints_that_do_not_fit_the_run_exit_with_status_2() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("mi");
+    exact_run(&dir, "sepg-mi");
+
+    // summary.json whose final parameters have two mean components for a 1-D policy.
+    let summary = dir.join("summary.json");
+    let text = fs::read_to_string(&summary).expect("summary");
+    let mut s: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let v = s["final"]["v"][0].clone();
+    s["final"]["v"] = serde_json::json!([v, v]);
+    fs::write(&summary, s.to_string()).expect("write");
+    assert_malformed(&dir, "the final parameters do not fit the run");
+    fs::write(&summary, &text).expect("restore");
+
+    // The interrupted folder, broken four ways.
+    let ck = interrupt_after_8(&dir);
+    let checkpoint = dir.join("checkpoint.json");
+    let partial = dir.join("log.partial.csv");
+    let restore = || fs::write(&checkpoint, ck.to_string()).expect("restore");
+
+    let mut long = ck.clone();
+    long["log_bytes"] = (fs::metadata(&partial).expect("partial").len() + 1).into();
+    fs::write(&checkpoint, long.to_string()).expect("write");
+    assert_malformed(&dir, "shorter than its checkpoint says");
+
+    let mut wide = ck.clone();
+    wide["state"]["w"] = serde_json::json!([0.0, 0.0]);
+    fs::write(&checkpoint, wide.to_string()).expect("write");
+    assert_malformed(&dir, "does not fit the run's configuration");
+
+    let mut late = ck.clone();
+    late["state"]["iteration"] = 13.into();
+    fs::write(&checkpoint, late.to_string()).expect("write");
+    assert_malformed(&dir, "does not fit the run's configuration");
+
+    fs::remove_file(&checkpoint).expect("remove");
+    assert_malformed(&dir, "without a valid checkpoint.json");
+    restore();
+    assert_eq!(sepg(&["audit", path(&dir)]).status.code(), Some(2));
+
+    fs::remove_file(&partial).expect("remove");
+    assert_malformed(&dir, "no log.csv and no readable log.partial.csv");
 }
 
 #[test]
