@@ -9,4 +9,5 @@ mod cli_reproduce;
 mod cli_run;
 mod cli_sweep;
 mod common;
+mod docs;
 mod robustness;
