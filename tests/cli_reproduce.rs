@@ -129,6 +129,9 @@ fn figures_and_plots_are_png_and_svg() {
     let none = sepg(&["plot", d, "--quiet", "--band", "none"]);
     assert!(none.status.success() && none.stderr.is_empty());
     assert!(dir.join("plot.png").is_file() && dir.join("plot.svg").is_file());
+    // The budget panel carries its B = 0 line (in the legend as a reference line).
+    let sweep_svg = std::fs::read_to_string(dir.join("plot.svg")).expect("svg");
+    assert!(sweep_svg.contains("B = 0") && sweep_svg.contains("budget"));
     let run = dir.join("runs/lqg/mi/sigma-1.0/seed-0");
     let file = tmp.path().join("one.svg");
     ok(&[
@@ -137,11 +140,8 @@ fn figures_and_plots_are_png_and_svg() {
         "--out",
         file.to_str().expect("utf-8"),
     ]);
-    assert!(
-        std::fs::read_to_string(&file)
-            .expect("svg")
-            .contains("budget")
-    );
+    let run_svg = std::fs::read_to_string(&file).expect("svg");
+    assert!(run_svg.contains("budget") && run_svg.contains("B = 0"));
 }
 
 /// `sepg reproduce fig-5.1` on `lqg1d` with two seeds of 5 iterations into `d`, with
