@@ -141,6 +141,7 @@ DEPENDENTS = {
     "sepg-estimators": ["sepg-algo", "sepg-verification"],
     "sepg-algo": ["sepg-verification"],
     "sepg-verification": [],
+    "sepg-runs": ["sepg"],
 }
 
 

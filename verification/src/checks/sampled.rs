@@ -1211,3 +1211,67 @@ pub(crate) fn checks() -> Vec<Check> {
         Check::new(b2, baseline_b_2),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// P(X ≥ k) for X ~ Binomial(n, p), summed term by term (independent of `crate::stats`).
+    fn upper_tail(k: u64, n: u64, p: f64) -> f64 {
+        let mut pmf = (1.0 - p).powi(n as i32);
+        let mut tail = if k == 0 { pmf } else { 0.0 };
+        for j in 1..=n {
+            pmf *= (n - j + 1) as f64 / j as f64 * p / (1.0 - p);
+            if j >= k {
+                tail += pmf;
+            }
+        }
+        tail
+    }
+
+    /// `others` clean tests (0 violations in 1000 trials) and one with `k` violations in 100
+    /// trials, each allowed a rate of 0.05.
+    fn family(k: u64, others: usize) -> Vec<Freq> {
+        let mut tests: Vec<Freq> = (0..others)
+            .map(|i| Freq {
+                name: format!("clean {i}"),
+                violations: 0,
+                trials: 1000,
+                allowed: 0.05,
+            })
+            .collect();
+        tests.push(Freq {
+            name: "tested".into(),
+            violations: k,
+            trials: 100,
+            allowed: 0.05,
+        });
+        tests
+    }
+
+    fn rejected(tests: &[Freq]) -> bool {
+        matches!(frequency_outcome(tests).outcome, Outcome::Violated { .. })
+    }
+
+    #[test]
+    fn frequency_tests_are_bonferroni_corrected() {
+        // The one-sided Clopper–Pearson lower bound at confidence 1 − a exceeds p₀ exactly when
+        // P(X ≥ k | p₀) < a. With m tests at family-wise 1e-3, a = 1e-3/m.
+        let (t13, t14, t16) = (
+            upper_tail(13, 100, 0.05),
+            upper_tail(14, 100, 0.05),
+            upper_tail(16, 100, 0.05),
+        );
+        assert!(t13 > 1e-3 && t13 < 1e-2, "{t13}");
+        assert!(t14 > 1e-4 && t14 < 1e-3, "{t14}");
+        assert!(t16 < 1e-4, "{t16}");
+        // Alone (a = 1e-3): 14 violations are rejected, 13 are not.
+        assert!(rejected(&family(14, 0)));
+        assert!(!rejected(&family(13, 0)));
+        // Among 10 tests (a = 1e-4): 14 is no longer rejected, 16 still is; 13 is not (it
+        // would be at a = 1e-2, the level of a correction that multiplies instead of divides).
+        assert!(!rejected(&family(14, 9)));
+        assert!(!rejected(&family(13, 9)));
+        assert!(rejected(&family(16, 9)));
+    }
+}
