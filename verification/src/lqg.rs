@@ -111,7 +111,10 @@ mod tests {
         // From the boxes and rewards (docs/CONVENTIONS.md §1): lqg has S = A = [−2, 2] and
         // reward −0.5(s² + a²), so R = 0.5(4 + 4) = 4, M_φ = 2, |A| = 4; lqg1d has
         // S = A = [−4, 4] and −0.9(s² + a²), so R = 0.9(16 + 16) = 28.8, M_φ = 4, |A| = 8.
-        for (preset, r, m, a) in [(Preset::Lqg, 4.0, 2.0, 4.0), (Preset::Lqg1d, 28.8, 4.0, 8.0)] {
+        for (preset, r, m, a) in [
+            (Preset::Lqg, 4.0, 2.0, 4.0),
+            (Preset::Lqg1d, 28.8, 4.0, 8.0),
+        ] {
             let task = Task::new(preset, 0.9).expect("preset builds");
             let k = &task.k;
             assert_eq!(k.gamma(), 0.9);
