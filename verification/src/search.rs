@@ -45,7 +45,7 @@ impl Comparison {
         }
     }
 
-    fn fails(&self, kind: ClaimKind, tol: Tolerance) -> bool {
+    pub(crate) fn fails(&self, kind: ClaimKind, tol: Tolerance) -> bool {
         let s = self.shortfall(kind);
         s.is_nan() || s > tol.allowed(self.truth, self.claimed)
     }

@@ -209,9 +209,9 @@ fn v_step_c_halved(
     grad: &[f64],
     required: f64,
 ) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
-    // The safe interval of a bound with c/2 is the one of c for the doubled requirement,
-    // with steps doubled.
-    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, 2.0 * required)?;
+    // The safe interval of a bound with c/2 is the one of c for half the requirement, with
+    // steps doubled: (2α)n² − (2α)²(c/2)n² = 2(αn² − α²cn²).
+    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 2.0)?;
     Ok(match out {
         sepg_bounds::outcome::StepOutcome::Feasible(s) => {
             sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
@@ -234,6 +234,51 @@ fn v_bound_c_tiny(
 ) -> Result<f64, sepg_bounds::BoundsError> {
     let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
     Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1e-3)? * n * n)
+}
+
+/// The v-update bound with c/30 (the safe interval of c/30 is the one of c for 30 times the
+/// requirement, with steps times 30).
+fn v_bound_c_30(
+    k: &sepg_bounds::constants::TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+    alpha: f64,
+) -> Result<f64, sepg_bounds::BoundsError> {
+    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+    Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1.0 / 30.0)? * n * n)
+}
+
+fn v_step_c_30(
+    k: &sepg_bounds::constants::TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+    required: f64,
+) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
+    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 30.0)?;
+    Ok(match out {
+        sepg_bounds::outcome::StepOutcome::Feasible(s) => {
+            sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
+                c_max: 30.0 * s.c_max,
+                vertex: 30.0 * s.vertex,
+                lo: 30.0 * s.lo,
+                hi: 30.0 * s.hi,
+                ..s
+            })
+        }
+        other => other,
+    })
+}
+
+#[test]
+fn a_c_thirty_times_too_small_is_caught_against_the_true_j() {
+    // The control steps of thm-4.2-v-update (lqg at γ = 0, where the closed form predicts the
+    // violation) catch c/30 in the bound together with its safe interval.
+    let b = BoundFns {
+        v_update_bound: v_bound_c_30,
+        v_safe_step: v_step_c_30,
+        ..BoundFns::default()
+    };
+    assert_eq!(run_broken("thm-4.2-v-update", b), ("violated", false));
 }
 
 #[test]
