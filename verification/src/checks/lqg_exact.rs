@@ -777,6 +777,24 @@ M_φ, |A| and policy, so they apply verbatim; R, M_φ, |A| from the preset";
 const FAR: &str = "0: exact oracle values; the relative tolerance 1e-4 on improvements larger \
 than 1e-7·|J| exceeds the oracle error by three orders of magnitude";
 
+/// Basis of the expected outcome of the checks with the printed c (Theorems 3.10, 3.14, 4.2,
+/// Corollary 4.4).
+const BASIS_C: &str = "theory for σ ≤ 1.649 on lqg and σ ≤ 3.297 on lqg1d, where the box term of \
+    c bounds the curvature of the Gaussian on ℝ (docs/ERRATA.md §27); for the larger σ sampled \
+    (up to 4) the printed c is unproven for clipped Gaussians, and the expected outcome there \
+    rests on the exact J of the DP oracle, an independent computation of the truth (not of the \
+    bound); the power control of thm-4.2-v-update (closed-form J at γ = 0) shows that this \
+    comparison sees a c 30 times too small";
+
+/// Basis of the expected outcome of the checks with the thesis form of the w-bound.
+const BASIS_D: &str = "theory where the thesis form is at most the rigorous bound \
+    (sepg_bounds::rigorous, proven for every σ with the real-line constant K_W) and, for c, \
+    below the thresholds of docs/ERRATA.md §27; where the thesis form exceeds the rigorous \
+    bound (ERRATA §10, §27; thm-4.3-neglected-terms isolates those steps) the statement is \
+    unproven and the expected outcome rests on the exact J of the DP oracle, an independent \
+    computation of the truth; thm-4.3-w-update-thesis's power control (closed-form J at \
+    γ = 0) shows that this comparison sees a d 30 times too small";
+
 fn meta(id: &str, statement: &str, location: &str, claim: &str) -> CheckMeta {
     CheckMeta {
         id: id.into(),
@@ -808,6 +826,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "J(θ + α∇J) − J(θ) ≥ α‖∇J‖₂² − α²c‖∇J‖₁² for α ∈ {α*, drawn in [0, 2α*]}, and at \
          α* = ‖∇‖₂²/(2c‖∇‖₁²) the improvement is ≥ α*‖∇J‖₂²/2 (sepg_bounds::pirotta).",
     );
+    t310.basis = BASIS_C.into();
     t310.notes = "Holds with a large margin (see the penalty ratio). The clipped presets have one \
         mean parameter (m = 1), so ‖·‖₁ = ‖·‖₂ = ‖·‖∞ here."
         .into();
@@ -818,6 +837,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "J(θ + Λ∇J) − J(θ) ≥ ∇JᵀΛ∇J − c‖Λ∇J‖₁² for Λ = α_k (greedy coordinate, α_k = 1/(2c)) \
          and drawn α ∈ [0, 1/c], and the greedy step gains ≥ ‖∇J‖∞²/(4c) (sepg_bounds::papini).",
     );
+    t314.basis = BASIS_C.into();
     t314.notes = "Holds (m = 1 on the clipped presets).".into();
     let mut t42 = meta(
         "thm-4.2-v-update",
@@ -826,6 +846,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "For α in the safe interval of (4.10) for C (its vertex α* = 1/(2c), both ends — the \
          largest ᾱ = (1 + λ_v)α* — and a drawn step): J(v + α∇_vJ, w) − J(v, w) ≥ (4.8) and ≥ C.",
     );
+    t42.basis = BASIS_C.into();
     t42.notes = "Holds. The penalty ratio shows how conservative c is: the true curvature stays \
         below 6% of c on these tasks, so a c divided by 2 is not caught by the true J \
         (thm-4.2-closed-form catches it)."
@@ -857,6 +878,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "For β in the safe interval (4.17) (vertex β* = 1/(2d), both ends, a drawn step): \
          J(v, w + β∇_wJ) − J(v, w) ≥ β∇_wJ² − β²d∇_wJ² and ≥ C.",
     );
+    t43.basis = BASIS_D.into();
     t43.notes = "Holds against the true J on the presets even where the thesis form exceeds the \
         rigorous bound (figure 'neglected part'): d is far larger than the true curvature."
         .into();
@@ -868,6 +890,10 @@ pub(crate) fn checks() -> Vec<Check> {
          (sepg_bounds::rigorous::bound) and ≥ C.",
     );
     t43r.notes = "Holds.".into();
+    t43r.basis = "theory: the rigorous bound is proven for every σ with the real-line constant \
+        K_W (docs/CONVENTIONS.md §4, docs/ERRATA.md §27); the power control (closed-form J at \
+        γ = 0) shows that the comparison with the exact J sees its penalty divided by 30"
+        .into();
     let mut t43n = meta(
         "thm-4.3-neglected-terms",
         "Theorem 4.3: the neglected o(Δw³) terms",
@@ -897,6 +923,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "Section 4.3.3, thesis line 1015",
         "The v-update with α* = 1/(2c) improves J by at least L = ‖∇_vJ‖₂²/(4mc).",
     );
+    c44.basis = BASIS_C.into();
     c44.notes = "Holds (m = 1, so L = C_max^v).".into();
     let mut gl = meta(
         "app-b-surrogate-gradient",
@@ -933,6 +960,7 @@ pub(crate) fn checks() -> Vec<Check> {
          largest β̄ = β̃ + λ_w|β̃| — and a drawn step): J(v, w + β∇_wL) − J(v, w) ≥ \
          β∇_wL∇_wJ − β²d∇_wL² and ≥ νC; the same with the rigorous interval and bound.",
     );
+    t45.basis = BASIS_D.into();
     t45.notes = "Holds.".into();
     let mut e420 = meta(
         "eq-4.20-combined-update",
@@ -941,6 +969,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "v-step ᾱ = (1 + λ_v)α* for (1 − ν)C, then w-step β̄ along ∇_wL(v^{t+1}, w) for νC, for \
          C = κ·min(C_max^v, C_max^w): each half meets its share and J(θ^{t+1}) − J(θ^t) ≥ C.",
     );
+    e420.basis = BASIS_D.into();
     e420.notes = "Holds (cases where νC exceeds C_max^w at v^{t+1} are skipped).".into();
     vec![
         Check::new(t310, thm_3_10),
