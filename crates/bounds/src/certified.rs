@@ -799,8 +799,8 @@ fn certify_predicted(
         };
         let ulp = (toward(1) - s.hi).abs();
         let predicted = (required - first.lo()) / (bound.slope(s.hi)?.abs() * ulp);
-        // also rejects NaN; 2⁵² bounds the cast below
-        if !(predicted < 4_503_599_627_370_496.0) {
+        // 2⁵² bounds the cast below; NaN is rejected too
+        if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         let n = (predicted.max(0.0) * 1.125 + 2.0) as u64;

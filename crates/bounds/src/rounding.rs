@@ -62,7 +62,7 @@ const C_ROUNDINGS: u32 = 14;
 /// Roundings of [`constants::d`] (module docs).
 const D_ROUNDINGS: u32 = 12;
 /// 2⁻¹⁰⁷⁰: covers the underflow terms of [`Parabola::enclose`] (module docs).
-const UNDERFLOW_SLACK: f64 = 16.0 * 4.940_656_458_412_465_4e-324;
+const UNDERFLOW_SLACK: f64 = 16.0 * f64::from_bits(1);
 /// The range [2⁻¹⁰⁰, 2¹⁰⁰] in which the task constants and σ keep c and d normal.
 const BOX_LO: f64 = 7.888_609_052_210_118e-31;
 const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
