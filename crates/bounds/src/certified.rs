@@ -16,6 +16,13 @@
 //! any form into a [`Certified`] outcome, so a new step form is certified by implementing the
 //! trait for its bound.
 //!
+//! The step functions below first try a cheaper certificate: the bound evaluated in plain
+//! `f64` with an a-priori bound on its rounding error (standard model of floating-point
+//! arithmetic, γ_k = k·u/(1 − k·u); the analysis is in docs/THEOREMS.md, "Certified steps"),
+//! and fall back to interval arithmetic when that analysis does not apply or does not certify
+//! a step ([`CertifiedStep::by_error_bound`] says which). The rigorous forms and
+//! [`adaptive_step`] use interval arithmetic only.
+//!
 //! | function | bound | thesis |
 //! |---|---|---|
 //! | [`v_safe_step`] | α‖∇_vJ‖∞² − α²c‖∇_vJ‖∞² | Theorem 4.2 |
@@ -23,6 +30,8 @@
 //! | [`w_safe_step_along_l`] | β∇_wL∇_wJ − β²d(∇_wL)² | Theorem 4.5 |
 //! | [`hp_v_safe_step`], [`hp_w_safe_step_along_j`], [`hp_w_safe_step_along_l`] | high-probability forms | Theorems 4.7–4.9 |
 //! | [`rigorous_safe_step_along_j`], [`rigorous_safe_step_along_l`] | rigorous w-bound | [`crate::rigorous`] |
+//! | [`exploring_safe_step`] | Δw·∇̂_wJ − \|Δw\|·ε_J − d(σ)Δw² | docs/THEOREMS.md, Theorem E |
+//! | [`adaptive_step`] | α‖∇J‖₂² − α²c(σ)‖∇J‖₁² (guarantee only) | Theorem 3.10, Corollary 3.11 |
 
 use crate::constants::{self, TaskConstants};
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, non_negative, positive};
