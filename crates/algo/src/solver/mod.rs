@@ -156,6 +156,18 @@ impl PolicySolver {
         self
     }
 
+    /// Replaces the SEPG options of this solver, e.g. one built by
+    /// [`PolicySolver::with_collector`], which starts from [`SepgOptions::default`] (a
+    /// collector that reproduces the thesis's pseudocode sets `reference_batch` to 0).
+    ///
+    /// # Errors
+    /// As [`SepgOptions::validate`].
+    pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
+        options.validate()?;
+        self.options = options;
+        Ok(self)
+    }
+
     /// The solver of `config` with every batch collected by `collector` and estimated by
     /// [`BlockEstimator`]: the same iteration code as [`PolicySolver::new`] in the sampled
     /// mode, so a collector that reproduces the built-in rollouts reproduces their records.
