@@ -4,7 +4,7 @@
 //! the interval arithmetic of the certified steps (`Interval`, `Enclosure`, `Certified`).
 //! Vectors are any one-dimensional array-like of floats; steps and improvements are in the
 //! units of the parameters and of J. The functions are defined by one table
-//! ([`bound_fns!`]) that converts the arguments and errors the same way for every one.
+//! (`bound_fns!`) that converts the arguments and errors the same way for every one.
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use sepg_bounds::budget::{self, Budget};

@@ -73,11 +73,11 @@ fn exact<'py>(
     Ok(out)
 }
 
+/// Means `(k,)` and 95% intervals `(k, 2)` of an estimate.
+type Means<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// The means and 95% intervals of an estimate, as `(means (k,), intervals (k, 2))`.
-fn arrays<'py>(
-    py: Python<'py>,
-    i: &Interval,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+fn arrays<'py>(py: Python<'py>, i: &Interval) -> PyResult<Means<'py>> {
     let (mean, ci): (Vec<f64>, Vec<Vec<f64>>) = match i {
         Interval::Scalar { mean, ci95 } => (vec![*mean], vec![ci95.to_vec()]),
         Interval::Vector { mean, ci95 } => {
