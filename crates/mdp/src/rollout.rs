@@ -831,7 +831,7 @@ fn scalar_kernel_impl<
                 mu
             };
             let ac = if CLIP {
-                a.clamp(p.action_low, p.action_high)
+                clip(a, p.action_low, p.action_high)
             } else {
                 a
             };
@@ -849,7 +849,7 @@ fn scalar_kernel_impl<
                 x += eta[k];
             }
             s[k] = if CLIP {
-                x.clamp(p.state_low, p.state_high)
+                clip(x, p.state_low, p.state_high)
             } else {
                 x
             };
@@ -857,6 +857,15 @@ fn scalar_kernel_impl<
         disc *= p.gamma;
     }
     ret
+}
+
+/// `x` clipped to `[lo, hi]` for `lo ≤ hi`: exactly [`f64::clamp`] (NaN stays NaN, the
+/// bounds themselves are returned at the ends), without its check of `lo ≤ hi`, which the
+/// environment's validation has already made; this compiles to a branch-free max and min.
+#[inline(always)]
+fn clip(x: f64, lo: f64, hi: f64) -> f64 {
+    let x = if x < lo { lo } else { x };
+    if x > hi { hi } else { x }
 }
 
 /// The policy of a rollout that runs a fused kernel instead of the generic one: Mountain Car
