@@ -28,6 +28,7 @@ use crate::env::{Environment, ScalarLqg};
 use crate::features::FeatureMap;
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uniform};
+use crate::stream::Streamer;
 
 /// Number of trajectories in one parallel work item.
 pub const CHUNK: usize = 64;
@@ -284,46 +285,17 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
 ) -> Result<(), RolloutError> {
     check(env, policy, n, horizon)?;
     out.resize(n, 0.0);
-    let gamma = env.gamma();
-    let limit = env.time_limit().map_or(horizon, |tl| tl.min(horizon));
-    let (sigma, inv_sigma) = policy.sigma_raw();
-    if let Some(p) = env.as_scalar_lqg().and_then(|e| e.scalar()) {
-        let v = policy.v()[0];
-        if policy.is_deterministic() {
-            let pol = ScalarPolicy {
-                v,
-                sigma: 0.0,
-                inv_sigma: 0.0,
-                score: ScoreAction::Raw,
-            };
-            fill_returns_scalar::<false>(out, key, p, pol, limit);
-        } else {
-            let pol = ScalarPolicy {
-                v,
-                sigma: sigma[0],
-                inv_sigma: inv_sigma[0],
-                score: ScoreAction::Raw,
-            };
-            fill_returns_scalar::<true>(out, key, p, pol, limit);
-        }
+    let s = Streamer::new(env, policy, horizon, key, ScoreAction::Raw)?;
+    let body = |c: usize, chunk: &mut [f64]| {
+        let mut scratch = s.scratch();
+        s.returns((c * CHUNK) as u64, chunk, &mut scratch);
+    };
+    if n <= CHUNK {
+        body(0, out);
     } else {
-        let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
-        let fused = FusedPolicy::of(env, policy, ScoreAction::Raw);
-        fill_returns(out, key, dims, |rngs, sc| {
-            let raw = ScoreAction::Raw;
-            kernel(
-                env,
-                policy,
-                fused,
-                raw,
-                gamma,
-                limit,
-                rngs,
-                &mut NoSteps,
-                sc,
-            )
-            .1
-        });
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| body(c, chunk));
     }
     if out.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -535,8 +507,19 @@ where
         }
         finite
     };
-    if batch.n <= CHUNK {
-        let b = batch;
+    for_each_chunk(batch, body)
+}
+
+/// Runs `body(c, rewards, scores_v, scores_w, lengths)` on the rows of every chunk `c` of
+/// [`CHUNK`] trajectories of `batch`, in parallel (on the calling thread when there is a single
+/// chunk); returns whether every call returned `true`.
+fn for_each_chunk<F>(batch: &mut Batch, body: F) -> bool
+where
+    F: Fn(usize, &mut [f64], &mut [f64], &mut [f64], &mut [usize]) -> bool + Sync,
+{
+    let (h, dv, dw) = (batch.horizon, batch.dim_v, batch.dim_w);
+    let b = batch;
+    if b.n <= CHUNK {
         return body(
             0,
             &mut b.disc_rewards,
@@ -545,12 +528,11 @@ where
             &mut b.lengths,
         );
     }
-    batch
-        .disc_rewards
+    b.disc_rewards
         .par_chunks_mut(CHUNK * h)
-        .zip(batch.cum_score_v.par_chunks_mut(CHUNK * h * dv))
-        .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h * dw))
-        .zip(batch.lengths.par_chunks_mut(CHUNK))
+        .zip(b.cum_score_v.par_chunks_mut(CHUNK * h * dv))
+        .zip(b.cum_score_w.par_chunks_mut(CHUNK * h * dw))
+        .zip(b.lengths.par_chunks_mut(CHUNK))
         .enumerate()
         .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
         .reduce(|| true, |a, b| a & b)
@@ -583,29 +565,6 @@ fn pad_scores(scores: &mut [f64], dim: usize, len: usize) {
             }
         }
         None => rest.fill(0.0),
-    }
-}
-
-/// Runs `kernel` for every trajectory in parallel chunks (on the calling thread when there is
-/// a single chunk), storing its discounted return.
-fn fill_returns<F>(out: &mut [f64], key: SeedKey, dims: (usize, usize, usize), kernel: F)
-where
-    F: Fn(&mut TrajectoryRngs, &mut Scratch) -> f64 + Sync,
-{
-    let prefix = key.prefix();
-    let body = |c: usize, chunk: &mut [f64]| {
-        let mut scratch = Scratch::new(dims);
-        for (k, g) in chunk.iter_mut().enumerate() {
-            let mut rngs = rngs_from_prefix(prefix, (c * CHUNK + k) as u64);
-            *g = kernel(&mut rngs, &mut scratch);
-        }
-    };
-    if out.len() <= CHUNK {
-        body(0, out);
-    } else {
-        out.par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| body(c, chunk));
     }
 }
 
@@ -663,25 +622,7 @@ fn fill_batch_scalar(
         }
         finite
     };
-    if batch.n <= CHUNK {
-        let b = batch;
-        return body(
-            0,
-            &mut b.disc_rewards,
-            &mut b.cum_score_v,
-            &mut b.cum_score_w,
-            &mut b.lengths,
-        );
-    }
-    batch
-        .disc_rewards
-        .par_chunks_mut(CHUNK * h)
-        .zip(batch.cum_score_v.par_chunks_mut(CHUNK * h))
-        .zip(batch.cum_score_w.par_chunks_mut(CHUNK * h))
-        .zip(batch.lengths.par_chunks_mut(CHUNK))
-        .enumerate()
-        .map(|(c, (((rw, sv), sw), lens))| body(c, rw, sv, sw, lens))
-        .reduce(|| true, |a, b| a & b)
+    for_each_chunk(batch, body)
 }
 
 /// Runs the scored scalar kernel on `K` consecutive trajectories whose rows are consecutive in
@@ -712,45 +653,6 @@ fn scalar_group<const K: usize>(
     let g = scalar_kernel::<K, _, true>(p, pol, limit, &mut rngs, &mut rows);
     let last = limit - 1;
     (0..K).all(|k| finite_trajectory(g[k], &v[k * h + last..][..1], &w[k * h + last..][..1]))
-}
-
-/// [`fill_returns`] for the scalar LQG (`STOCH = false`: the deterministic policy).
-fn fill_returns_scalar<const STOCH: bool>(
-    out: &mut [f64],
-    key: SeedKey,
-    p: &ScalarLqg,
-    pol: ScalarPolicy,
-    limit: usize,
-) {
-    let prefix = key.prefix();
-    let body = |c: usize, chunk: &mut [f64]| {
-        for (g, group) in chunk.chunks_mut(LANES).enumerate() {
-            let first = (c * CHUNK + g * LANES) as u64;
-            if group.len() == LANES {
-                let mut rngs: [TrajectoryRngs; LANES] =
-                    std::array::from_fn(|k| rngs_from_prefix(prefix, first + k as u64));
-                group.copy_from_slice(&scalar_kernel::<LANES, _, STOCH>(
-                    p,
-                    pol,
-                    limit,
-                    &mut rngs,
-                    &mut NoSteps,
-                ));
-            } else {
-                for (k, g) in group.iter_mut().enumerate() {
-                    let mut rngs = [rngs_from_prefix(prefix, first + k as u64)];
-                    *g = scalar_kernel::<1, _, STOCH>(p, pol, limit, &mut rngs, &mut NoSteps)[0];
-                }
-            }
-        }
-    };
-    if out.len() <= CHUNK {
-        body(0, out);
-    } else {
-        out.par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| body(c, chunk));
-    }
 }
 
 /// The fused kernel of the scalar LQG (docs/CONVENTIONS.md §1 step order) on `K` trajectories in lockstep,

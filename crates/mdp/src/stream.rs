@@ -153,6 +153,28 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         std::array::from_fn(|k| rngs_from_prefix(self.prefix, first + k as u64))
     }
 
+    /// Trajectory `index` through `sink` with the generic kernel (or the fused Mountain Car
+    /// one), then the steps `len .. horizon` after its end as padding (reward 0, scores frozen,
+    /// as in a [`crate::Batch`]). Returns `(len, G)`.
+    fn padded<S: TrajSink>(&self, index: u64, sink: &mut S, sc: &mut Scratch) -> (usize, f64) {
+        let mut rngs = rngs_from_prefix(self.prefix, index);
+        let (len, g) = kernel(
+            self.env,
+            self.policy,
+            self.fused,
+            self.score,
+            self.gamma,
+            self.limit,
+            &mut rngs,
+            sink,
+            sc,
+        );
+        for t in len..self.horizon {
+            sink.record(t, 0.0, &sc.cum_v, &sc.cum_w);
+        }
+        (len, g)
+    }
+
     /// The discounted returns of trajectories `first, first + 1, …` into `out`; returns the
     /// number of environment steps taken.
     pub(crate) fn returns(&self, first: u64, out: &mut [f64], sc: &mut Scratch) -> u64 {
@@ -164,18 +186,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             None => {
                 let mut steps = 0;
                 for (k, g) in out.iter_mut().enumerate() {
-                    let mut rngs = rngs_from_prefix(self.prefix, first + k as u64);
-                    let (len, ret) = kernel(
-                        self.env,
-                        self.policy,
-                        self.fused,
-                        self.score,
-                        self.gamma,
-                        self.limit,
-                        &mut rngs,
-                        &mut NoSteps,
-                        sc,
-                    );
+                    let (len, ret) = self.padded(first + k as u64, &mut NoSteps, sc);
                     *g = ret;
                     steps += len as u64;
                 }
@@ -219,7 +230,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         out: &mut [f64],
         sc: &mut Scratch,
     ) -> u64 {
-        let (dv, dw, h) = (self.dim_v(), self.dim_w(), self.horizon);
+        let (dv, dw) = (self.dim_v(), self.dim_w());
         let (ret, rest) = out.split_at_mut(count);
         let (gv, gw) = rest.split_at_mut(dv * count);
         if let Some((p, pol)) = self.scalar {
@@ -258,27 +269,13 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         for i in 0..count {
             acc_v.fill(0.0);
             acc_w.fill(0.0);
-            let mut rngs = rngs_from_prefix(self.prefix, first + i as u64);
             let mut sink = GpomdpTraj {
                 bv: &b.v,
                 bw: &b.w,
                 gv: &mut acc_v,
                 gw: &mut acc_w,
             };
-            let (len, g) = kernel(
-                self.env,
-                self.policy,
-                self.fused,
-                self.score,
-                self.gamma,
-                self.limit,
-                &mut rngs,
-                &mut sink,
-                sc,
-            );
-            for t in len..h {
-                sink.record(t, 0.0, &sc.cum_v, &sc.cum_w);
-            }
+            let (len, g) = self.padded(first + i as u64, &mut sink, sc);
             ret[i] = g;
             for (k, a) in acc_v.iter().enumerate() {
                 gv[k * count + i] = *a;
@@ -351,25 +348,11 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         }
         let mut steps = 0;
         for i in 0..count {
-            let mut rngs = rngs_from_prefix(self.prefix, first + i as u64);
             let mut sink = FitSink {
                 sums: &mut *sums,
                 last: (0.0, 0.0),
             };
-            let (len, _) = kernel(
-                self.env,
-                self.policy,
-                self.fused,
-                self.score,
-                self.gamma,
-                self.limit,
-                &mut rngs,
-                &mut sink,
-                sc,
-            );
-            for t in len..h {
-                TrajSink::record(&mut sink, t, 0.0, &sc.cum_v, &sc.cum_w);
-            }
+            let (len, _) = self.padded(first + i as u64, &mut sink, sc);
             steps += len as u64;
         }
         steps
