@@ -112,10 +112,15 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         })
     }
 
-    /// Work buffers for the generic kernel.
+    /// Work buffers for the generic kernel (empty, so not allocated, for the scalar LQG
+    /// kernel, which needs none).
     pub(crate) fn scratch(&self) -> Scratch {
         let e = self.env;
-        Scratch::new((e.state_dim(), e.action_dim(), e.feature_dim()))
+        if self.scalar.is_some() {
+            Scratch::new((0, 0, 0))
+        } else {
+            Scratch::new((e.state_dim(), e.action_dim(), e.feature_dim()))
+        }
     }
 
     /// Number of v-components `dim_v`.
