@@ -1,11 +1,18 @@
-//! One sampled SEPG-ZV iteration on `lqg1d` with N = 100, H = 20 (three blocks: v, target, w).
+//! One sampled SEPG-ZV iteration on `lqg1d` with N = 100, H = 20 (three blocks: v, target, w),
+//! and, in the same run, its reference: the fused loop (`sepg_benches::fused::lqg1d`) over the
+//! same number of environment steps (100 trajectories of 20 steps at σ = 1 with their
+//! G(PO)MDP sums). Report the ratio reference ÷ iteration: the share of the iteration's time
+//! that the fused rollouts of its trajectories would take.
 //!
 //! Single-threaded figure: `RAYON_NUM_THREADS=1 cargo bench -p sepg-benches --bench algo`.
 use criterion::{Criterion, criterion_group, criterion_main};
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::executor::Solver;
 use sepg_algo::solver::PolicySolver;
+use sepg_benches::fused;
 use sepg_mdp::env::Preset;
+use sepg_mdp::rng::SeedKey;
+use std::hint::black_box;
 
 fn sepg_zv_iteration(c: &mut Criterion) {
     let checked = SepgConfig::new(Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Zv))
@@ -13,7 +20,25 @@ fn sepg_zv_iteration(c: &mut Criterion) {
         .expect("valid configuration");
     let mut solver = PolicySolver::new(&checked).expect("solver");
     let start = checked.initial_state();
-    c.bench_function("sepg_zv_iteration_lqg1d_n100_h20", |b| {
+    let mut group = c.benchmark_group("sepg_zv_iteration_lqg1d_n100_h20");
+    let zeros = [0.0; 20];
+    let mut it = 0u64;
+    // Run on a one-thread pool's own thread, so that the reference, like the iteration's
+    // blocks of at most 64 trajectories, makes no round trip to a thread pool.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
+    group.bench_function("fused_reference", |b| {
+        pool.install(|| {
+            b.iter(|| {
+                it += 1;
+                let key = SeedKey::new(1, it, 0);
+                black_box(fused::lqg1d(-0.1, 1.0, 100, 20, key, &zeros, &zeros))
+            })
+        })
+    });
+    group.bench_function("iteration", |b| {
         let mut state = start.clone();
         b.iter(|| {
             // Restart periodically so the benchmark stays near the reproduction's start.
@@ -23,6 +48,7 @@ fn sepg_zv_iteration(c: &mut Criterion) {
             solver.next_iter(&mut state).expect("iteration")
         })
     });
+    group.finish();
 }
 
 criterion_group!(benches, sepg_zv_iteration);

@@ -1,7 +1,8 @@
 //! Certified safe steps against the `f64` steps they wrap, measured in the same run:
 //! `cargo bench -p sepg-benches --bench certified`. The goal is a ratio ≤ 2
-//! (certified / uncertified) for the steps SEPG takes; the last group measures what it costs
-//! one SEPG iteration.
+//! (certified / uncertified) for the steps SEPG takes: the exact v- and w-steps (Theorems 4.2,
+//! 4.5), the sampled v-step (Theorem 4.7) and the default sampled w-step (the exploring
+//! w-update). The last group measures what certification costs one SEPG iteration.
 use criterion::{Criterion, criterion_group, criterion_main};
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::executor::Solver;
@@ -9,7 +10,7 @@ use sepg_algo::solver::PolicySolver;
 use sepg_bounds::certified;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HpForm};
-use sepg_bounds::{v_update, w_update};
+use sepg_bounds::{exploring, v_update, w_update};
 use sepg_mdp::env::Preset;
 use std::hint::black_box;
 
@@ -55,6 +56,18 @@ fn steps(c: &mut Criterion) {
                 required,
                 HpForm::SignAware,
             )
+        })
+    });
+    g.finish();
+    let mut g = c.benchmark_group("exploring_w_step");
+    g.bench_function("uncertified", |b| {
+        b.iter(|| {
+            exploring::w_exploring_step(&k, black_box(sigma), -0.3, 0.1, black_box(0.4), -0.01)
+        })
+    });
+    g.bench_function("certified", |b| {
+        b.iter(|| {
+            certified::exploring_safe_step(&k, black_box(sigma), -0.3, 0.1, black_box(0.4), -0.01)
         })
     });
     g.finish();

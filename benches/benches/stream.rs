@@ -7,7 +7,7 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use sepg_benches::fused;
 use sepg_mdp::{
-    Batch, LqgEnv, MountainCar,
+    Batch, Environment, LqgEnv, MountainCar,
     monte_carlo::{DEFAULT_PILOT, stream_gradients},
     policy::GaussianPolicy,
     rng::SeedKey,
@@ -15,100 +15,83 @@ use sepg_mdp::{
 };
 use std::hint::black_box;
 
+/// One benchmark group `name` of `n` trajectories of `h` steps (throughput in environment
+/// steps): the fused reference `reference(key)`, `stream_gradients` with `pilot` baseline
+/// trajectories and, if `batch`, scored rollouts into a `Batch`. Every call draws a new key.
+#[allow(clippy::too_many_arguments)]
+fn side_by_side<E: Environment, R>(
+    c: &mut Criterion,
+    name: &str,
+    env: &E,
+    pi: &GaussianPolicy,
+    (n, h): (usize, usize),
+    pilot: usize,
+    reference: impl Fn(SeedKey) -> R,
+    batch: bool,
+) {
+    let mut group = c.benchmark_group(name);
+    group.throughput(Throughput::Elements((n * h) as u64));
+    group.sample_size(20);
+    let size = format!("N{n}_H{h}");
+    let mut it = 0u64;
+    let mut key = || {
+        it += 1;
+        SeedKey::new(1, it, 0)
+    };
+    group.bench_function(BenchmarkId::new("fused_reference", &size), |b| {
+        b.iter(|| black_box(reference(key())))
+    });
+    group.bench_function(BenchmarkId::new("stream_gradients", &size), |b| {
+        b.iter(|| black_box(stream_gradients(env, pi, n, h, key(), pilot).expect("valid rollout")))
+    });
+    if batch {
+        let mut out = Batch::zeros(0, 0, 0, 0, 0.0);
+        group.bench_function(BenchmarkId::new("rollout_batch", &size), |b| {
+            b.iter(|| {
+                rollout_into(env, pi, n, h, key(), &mut out).expect("valid rollout");
+                black_box(&out);
+            })
+        });
+    }
+    group.finish();
+}
+
 fn lqg1d(c: &mut Criterion) {
-    let env = LqgEnv::lqg1d();
     let (v, sigma) = (-0.3, 0.5);
     let pi = GaussianPolicy::scalar(v, f64::ln(sigma)).expect("valid policy");
     let (n, h) = (200_000usize, 20usize);
     let zeros = vec![0.0; h];
-    let mut group = c.benchmark_group("stream/lqg1d");
-    group.throughput(Throughput::Elements((n * h) as u64));
-    group.sample_size(20);
-    let mut it = 0u64;
-    group.bench_function(
-        BenchmarkId::new("fused_reference", format!("N{n}_H{h}")),
-        |b| {
-            b.iter(|| {
-                it += 1;
-                black_box(fused::lqg1d(
-                    v,
-                    sigma,
-                    n,
-                    h,
-                    SeedKey::new(1, it, 0),
-                    &zeros,
-                    &zeros,
-                ))
-            })
-        },
+    let reference = |key| fused::lqg1d(v, sigma, n, h, key, &zeros, &zeros);
+    let env = LqgEnv::lqg1d();
+    side_by_side(
+        c,
+        "stream/lqg1d",
+        &env,
+        &pi,
+        (n, h),
+        DEFAULT_PILOT,
+        reference,
+        false,
     );
-    group.bench_function(
-        BenchmarkId::new("stream_gradients", format!("N{n}_H{h}")),
-        |b| {
-            b.iter(|| {
-                it += 1;
-                black_box(
-                    stream_gradients(&env, &pi, n, h, SeedKey::new(1, it, 0), DEFAULT_PILOT)
-                        .expect("valid rollout"),
-                )
-            })
-        },
-    );
-    group.finish();
 }
 
 fn mountain_car(c: &mut Criterion) {
-    let env = MountainCar::state_bias();
     let (v, sigma) = ([0.0, 0.0, 0.0], 0.2);
     let pi = GaussianPolicy::new(v.to_vec(), vec![f64::ln(sigma)], 3).expect("valid policy");
     let (n, h) = (200usize, 999usize);
     let (zv, zw) = (vec![0.0; 3 * h], vec![0.0; h]);
-    let mut group = c.benchmark_group("stream/mountain-car");
-    group.throughput(Throughput::Elements((n * h) as u64));
-    group.sample_size(20);
-    let mut it = 0u64;
-    group.bench_function(
-        BenchmarkId::new("fused_reference", format!("N{n}_H{h}")),
-        |b| {
-            b.iter(|| {
-                it += 1;
-                black_box(fused::mountain_car(
-                    v,
-                    sigma,
-                    n,
-                    h,
-                    SeedKey::new(1, it, 0),
-                    &zv,
-                    &zw,
-                ))
-            })
-        },
+    let reference = |key| fused::mountain_car(v, sigma, n, h, key, &zv, &zw);
+    let env = MountainCar::state_bias();
+    side_by_side(
+        c,
+        "stream/mountain-car",
+        &env,
+        &pi,
+        (n, h),
+        0,
+        reference,
+        true,
     );
-    group.bench_function(
-        BenchmarkId::new("stream_gradients", format!("N{n}_H{h}")),
-        |b| {
-            b.iter(|| {
-                it += 1;
-                black_box(
-                    stream_gradients(&env, &pi, n, h, SeedKey::new(1, it, 0), 0)
-                        .expect("valid rollout"),
-                )
-            })
-        },
-    );
-    let mut batch = Batch::zeros(0, 0, 0, 0, 0.0);
-    group.bench_function(
-        BenchmarkId::new("rollout_batch", format!("N{n}_H{h}")),
-        |b| {
-            b.iter(|| {
-                it += 1;
-                rollout_into(&env, &pi, n, h, SeedKey::new(1, it, 0), &mut batch)
-                    .expect("valid rollout");
-                black_box(&batch);
-            })
-        },
-    );
-    group.finish();
 }
 
 criterion_group!(benches, lqg1d, mountain_car);

@@ -20,15 +20,18 @@ reported as "does not apply" and is not counted in the kill rate.
 
 Stages, stopping at the first that fails (the mutant is then "killed" by that stage):
 
-    1. cargo test --release -p <crate> --no-fail-fast     (the crate's own tests and doctests)
+    1. cargo test --release -p <crate>                     (the crate's own tests and doctests)
     2. sepg verify --quick                                 (exit status 1 = a check differs)
-    3. cargo test --release -p <each crate that depends on it> --no-fail-fast
+    3. cargo test --release -p <each crate that depends on it>
        (the root package's CLI tests only for mutants of the CLI itself, as the other crates
        are exercised there through the same code paths the crate tests cover)
 
-A mutant that does not compile is reported as "does not compile" (not counted). The names of
-the failing tests are recorded, so a mutant caught only by a single-seed performance test can
-be spotted in the report.
+A mutant that does not compile is reported as "does not compile" (not counted). Each line of
+the output and each row of the table names the stage that killed the mutant and the failing
+tests (or, for `sepg verify --quick`, the checks whose outcome changed), so a mutant caught only
+by a single-seed performance test can be spotted. cargo stops at the first test binary that
+fails (the unit tests run first); --no-fail-fast runs every test binary of the stage and lists
+every failing test, at a higher cost.
 
 The scratch copy lives in --work (default /tmp/sepg-mutation): the working tree's tracked and
 untracked files (git ls-files) are copied to WORK/src, and WORK/target starts as a copy of the repository's
@@ -36,7 +39,7 @@ release target/ so that dependencies are not rebuilt. Run it niced, in the backg
 
     nice -n 10 python3 scripts/mutants/run.py > mutation.log 2>&1 &
 
-Options: --only ID[,ID...] (prefixes of the mutant file names), --timeout SECONDS per stage
+Options: --only ID[,ID...] (prefixes of the mutant file names), --no-fail-fast, --timeout SECONDS per stage
 (default 2400; a stage that times out kills the mutant), --out FILE (markdown table, default
 WORK/results.md), --no-baseline (skip the unmutated run that must pass first).
 Requires python3 and the Rust toolchain.
@@ -141,18 +144,20 @@ DEPENDENTS = {
     "sepg-estimators": ["sepg-algo", "sepg-verification"],
     "sepg-algo": ["sepg-verification"],
     "sepg-verification": [],
+    "sepg-runs": ["sepg"],
 }
 
 
-def stages(mutant):
+def stages(mutant, no_fail_fast=False):
     crate = mutant["crate"]
+    extra = ["--no-fail-fast"] if no_fail_fast else []
     out = [
-        ("crate tests", ["cargo", "test", "--release", "-p", crate, "--no-fail-fast"]),
+        ("crate tests", ["cargo", "test", "--release", "-p", crate] + extra),
         ("verify --quick", None),
     ]
     deps = DEPENDENTS.get(crate, [])
     if deps:
-        cmd = ["cargo", "test", "--release", "--no-fail-fast"]
+        cmd = ["cargo", "test", "--release"] + extra
         for d in deps:
             cmd += ["-p", d]
         out.append(("dependent crates' tests", cmd))
@@ -194,6 +199,7 @@ def main():
     ap.add_argument("--timeout", type=int, default=2400)
     ap.add_argument("--out", default="")
     ap.add_argument("--no-baseline", action="store_true")
+    ap.add_argument("--no-fail-fast", action="store_true")
     args = ap.parse_args()
 
     work = os.path.abspath(args.work)
@@ -213,7 +219,7 @@ def main():
         mutants = [m for m in mutants if any(m["id"].startswith(w) for w in wanted)]
 
     if not args.no_baseline:
-        for name, cmd in stages({"crate": "sepg-verification"}):
+        for name, cmd in stages({"crate": "sepg-verification"}, args.no_fail_fast):
             status, detail, secs = run_stage(name, cmd, src, env, args.timeout, log)
             print(f"baseline {name}: {status} ({secs:.0f} s) {detail}", flush=True)
             if status != "pass":
@@ -231,7 +237,7 @@ def main():
         log.write(f"\n===== {m['id']} ({os.path.relpath(path, src)})\n")
         status, stage, detail, total = "survived", "", "", 0.0
         try:
-            for name, cmd in stages(m):
+            for name, cmd in stages(m, args.no_fail_fast):
                 st, det, secs = run_stage(name, cmd, src, env, args.timeout, log)
                 total += secs
                 if st == "compile":
@@ -243,7 +249,8 @@ def main():
         finally:
             open(path, "w", encoding="utf-8").write(original)
         rows.append((m, status, stage, detail, total))
-        print(f"{m['id']}: {status} {stage} [{detail}] ({total:.0f} s)", flush=True)
+        by = f" at stage '{stage}' by: {detail}" if status == "killed" else ""
+        print(f"{m['id']}: {status}{by} ({total:.0f} s)", flush=True)
 
     counted = [r for r in rows if r[1] in ("killed", "survived")]
     killed = sum(1 for r in counted if r[1] == "killed")
@@ -252,7 +259,7 @@ def main():
         f"kill rate: {killed}/{len(counted)}"
         + (f" = {100.0 * killed / len(counted):.0f}%" if counted else ""),
         "",
-        "| mutant | crate | bug | result | stage | failing tests / checks |",
+        "| mutant | crate | bug | result | killed at stage | by (failing tests / changed checks) |",
         "|---|---|---|---|---|---|",
     ]
     for m, status, stage, detail, _ in rows:

@@ -233,21 +233,108 @@ fn outcome_fields(o: &StepOutcome) -> OutcomeFields {
     }
 }
 
+/// The required improvements (C_v, C_w): C for both, or split by ν (eqs. 4.13–4.14).
+fn requirements(a: &BoundsArgs) -> Result<(f64, f64), CliError> {
+    match a.nu {
+        Some(nu) => sepg_bounds::budget::split_requirement(a.required, nu).map_err(bad),
+        None if !a.required.is_finite() => Err(CliError::usage(format!(
+            "required must be finite, got {}",
+            a.required
+        ))),
+        None => Ok((a.required, a.required)),
+    }
+}
+
+/// The number m of mean parameters: --dim-v, checked against --grad-v, or the length of
+/// --grad-v.
+fn dim_v(a: &BoundsArgs) -> Result<Option<usize>, CliError> {
+    let m = match (&a.grad_v, a.dim_v) {
+        (Some(g), Some(m)) if g.len() != m => {
+            return Err(CliError::usage(format!(
+                "--dim-v {m} does not match the {} components of --grad-v",
+                g.len()
+            )));
+        }
+        (Some(g), _) => Some(g.len()),
+        (None, m) => m,
+    };
+    if m == Some(0) {
+        return Err(CliError::usage("--dim-v must be at least 1"));
+    }
+    Ok(m)
+}
+
+/// The quantities of ∇_v J: C_max, the safe v-steps, the greedy coordinate, the surrogate
+/// and the adaptive step of Corollary 3.11.
+fn fill_v(
+    r: &mut BoundsReport,
+    k: &TaskConstants,
+    sigma: f64,
+    g: &[f64],
+    required_v: f64,
+) -> Result<(), CliError> {
+    r.c_max_v = Some(v_update::c_max(k, sigma, g).map_err(bad)?);
+    let o = v_update::safe_step(k, sigma, g, required_v).map_err(bad)?;
+    (r.feasible_v, r.lambda_v, r.alpha_interval, r.alpha_bar) = outcome_fields(&o);
+    r.greedy_index = Some(papini::greedy_step(k, sigma, g).map_err(bad)?.index);
+    r.surrogate = Some(surrogate::surrogate(k, sigma, g).map_err(bad)?);
+    if let pirotta::AdaptiveStep::Step { alpha, guarantee } =
+        pirotta::optimal_step(k, sigma, g).map_err(bad)?
+    {
+        r.pirotta_alpha = Some(alpha);
+        r.pirotta_guarantee = Some(guarantee);
+    }
+    Ok(())
+}
+
+/// The quantities of ∇_w J (and ∇_w L): C_max and the safe w-steps along each.
+fn fill_w(
+    r: &mut BoundsReport,
+    a: &BoundsArgs,
+    k: &TaskConstants,
+    required_w: f64,
+) -> Result<(), CliError> {
+    let sigma = a.sigma;
+    match (a.grad_w, a.grad_w_l) {
+        (None, Some(_)) => return Err(CliError::usage("--grad-w-l needs --grad-w")),
+        (Some(gj), gl) => {
+            r.c_max_w = Some(w_update::c_max(k, sigma, gj).map_err(bad)?);
+            let oj = w_update::safe_step_along_j(k, sigma, gj, required_w).map_err(bad)?;
+            let (feasible, lambda, interval, bar) = outcome_fields(&oj);
+            (r.feasible_w, r.lambda_w, r.beta_interval_j, r.beta_bar_j) =
+                (feasible, lambda, interval, bar);
+            if let Some(gl) = gl {
+                r.beta_tilde = Some(w_update::beta_tilde(k, sigma, gj, gl).map_err(bad)?);
+                let ol = w_update::safe_step_along_l(k, sigma, gj, gl, required_w).map_err(bad)?;
+                let (_, _, interval, bar) = outcome_fields(&ol);
+                (r.beta_interval, r.beta_bar) = (interval, bar);
+            }
+        }
+        (None, None) => {}
+    }
+    Ok(())
+}
+
+/// The batch sizes of Corollary 3.13, when --delta, --eps and --horizon are all given.
+fn fill_batch(r: &mut BoundsReport, a: &BoundsArgs, k: &TaskConstants) -> Result<(), CliError> {
+    match (a.delta, a.eps, a.horizon) {
+        (Some(delta), Some(eps), Some(h)) => {
+            r.batch_reinforce =
+                Some(batch_size::reinforce(k, a.sigma, delta, eps, h).map_err(bad)?);
+            r.batch_gpomdp = Some(batch_size::gpomdp(k, a.sigma, delta, eps, h).map_err(bad)?);
+            Ok(())
+        }
+        (None, None, None) => Ok(()),
+        _ => Err(CliError::usage(
+            "batch sizes need all of --delta, --eps and --horizon",
+        )),
+    }
+}
+
 fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
     let k = TaskConstants::new(a.gamma, a.r_max, a.m_phi, a.action_volume).map_err(bad)?;
     let sigma = a.sigma;
-    let (required_v, required_w) = match a.nu {
-        Some(nu) => sepg_bounds::budget::split_requirement(a.required, nu).map_err(bad)?,
-        None => {
-            if !a.required.is_finite() {
-                return Err(CliError::usage(format!(
-                    "required must be finite, got {}",
-                    a.required
-                )));
-            }
-            (a.required, a.required)
-        }
-    };
+    let (required_v, required_w) = requirements(a)?;
     let c = constants::c(&k, sigma).map_err(bad)?;
     let mut r = BoundsReport {
         psi: constants::psi(),
@@ -260,68 +347,14 @@ fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
         required_w,
         ..BoundsReport::default()
     };
-
-    let dim_v = match (&a.grad_v, a.dim_v) {
-        (Some(g), Some(m)) if g.len() != m => {
-            return Err(CliError::usage(format!(
-                "--dim-v {m} does not match the {} components of --grad-v",
-                g.len()
-            )));
-        }
-        (Some(g), _) => Some(g.len()),
-        (None, m) => m,
-    };
-    if let Some(m) = dim_v {
-        if m == 0 {
-            return Err(CliError::usage("--dim-v must be at least 1"));
-        }
+    if let Some(m) = dim_v(a)? {
         r.surrogate_coefficient = Some(1.0 / (4.0 * m as f64 * c));
     }
-
     if let Some(g) = &a.grad_v {
-        r.c_max_v = Some(v_update::c_max(&k, sigma, g).map_err(bad)?);
-        let o = v_update::safe_step(&k, sigma, g, required_v).map_err(bad)?;
-        (r.feasible_v, r.lambda_v, r.alpha_interval, r.alpha_bar) = outcome_fields(&o);
-        r.greedy_index = Some(papini::greedy_step(&k, sigma, g).map_err(bad)?.index);
-        r.surrogate = Some(surrogate::surrogate(&k, sigma, g).map_err(bad)?);
-        if let pirotta::AdaptiveStep::Step { alpha, guarantee } =
-            pirotta::optimal_step(&k, sigma, g).map_err(bad)?
-        {
-            r.pirotta_alpha = Some(alpha);
-            r.pirotta_guarantee = Some(guarantee);
-        }
+        fill_v(&mut r, &k, sigma, g, required_v)?;
     }
-
-    match (a.grad_w, a.grad_w_l) {
-        (None, Some(_)) => return Err(CliError::usage("--grad-w-l needs --grad-w")),
-        (Some(gj), gl) => {
-            r.c_max_w = Some(w_update::c_max(&k, sigma, gj).map_err(bad)?);
-            let oj = w_update::safe_step_along_j(&k, sigma, gj, required_w).map_err(bad)?;
-            let (feasible, lambda, interval, bar) = outcome_fields(&oj);
-            (r.feasible_w, r.lambda_w, r.beta_interval_j, r.beta_bar_j) =
-                (feasible, lambda, interval, bar);
-            if let Some(gl) = gl {
-                r.beta_tilde = Some(w_update::beta_tilde(&k, sigma, gj, gl).map_err(bad)?);
-                let ol = w_update::safe_step_along_l(&k, sigma, gj, gl, required_w).map_err(bad)?;
-                let (_, _, interval, bar) = outcome_fields(&ol);
-                (r.beta_interval, r.beta_bar) = (interval, bar);
-            }
-        }
-        (None, None) => {}
-    }
-
-    match (a.delta, a.eps, a.horizon) {
-        (Some(delta), Some(eps), Some(h)) => {
-            r.batch_reinforce = Some(batch_size::reinforce(&k, sigma, delta, eps, h).map_err(bad)?);
-            r.batch_gpomdp = Some(batch_size::gpomdp(&k, sigma, delta, eps, h).map_err(bad)?);
-        }
-        (None, None, None) => {}
-        _ => {
-            return Err(CliError::usage(
-                "batch sizes need all of --delta, --eps and --horizon",
-            ));
-        }
-    }
+    fill_w(&mut r, a, &k, required_w)?;
+    fill_batch(&mut r, a, &k)?;
     if a.certified {
         r.certified = Some(compute_certified(a, &k, (required_v, required_w))?);
     }
@@ -332,29 +365,8 @@ fn fmt_opt(x: Option<f64>) -> String {
     x.map_or_else(|| "-".to_string(), |v| format!("{v:.6e}"))
 }
 
-fn render_table(r: &BoundsReport) -> String {
-    let mut rows: Vec<(&str, String, &str)> = vec![
-        ("psi", format!("{:.10}", r.psi), "Lemma A.1"),
-        (
-            "c",
-            format!("{:.6e}", r.c),
-            "Thm 4.2 (Papini et al. Thm 3.14)",
-        ),
-        ("d", format!("{:.6e}", r.d), "Thm 4.3"),
-        ("dc_dsigma", format!("{:.6e}", r.dc_dsigma), "Appendix B"),
-        (
-            "alpha_star",
-            format!("{:.6e}", r.alpha_star),
-            "Thm 4.2: 1/(2c)",
-        ),
-        (
-            "beta_star",
-            format!("{:.6e}", r.beta_star),
-            "Thm 4.3: 1/(2d)",
-        ),
-        ("required_v", format!("{:.6e}", r.required_v), "(4.13)"),
-        ("required_w", format!("{:.6e}", r.required_w), "(4.14)"),
-    ];
+/// The rows of the quantities that the inputs determine, in table order.
+fn push_optional_rows<'a>(r: &BoundsReport, rows: &mut Vec<(&'a str, String, &'a str)>) {
     let opt_rows: [(&str, Option<f64>, &str); 13] = [
         (
             "surrogate_coefficient",
@@ -410,28 +422,59 @@ fn render_table(r: &BoundsReport) -> String {
             rows.push((name, f.to_string(), "C <= C_max"));
         }
     }
+}
+
+fn render_table(r: &BoundsReport) -> String {
+    let mut rows: Vec<(&str, String, &str)> = vec![
+        ("psi", format!("{:.10}", r.psi), "Lemma A.1"),
+        (
+            "c",
+            format!("{:.6e}", r.c),
+            "Thm 4.2 (Papini et al. Thm 3.14)",
+        ),
+        ("d", format!("{:.6e}", r.d), "Thm 4.3"),
+        ("dc_dsigma", format!("{:.6e}", r.dc_dsigma), "Appendix B"),
+        (
+            "alpha_star",
+            format!("{:.6e}", r.alpha_star),
+            "Thm 4.2: 1/(2c)",
+        ),
+        (
+            "beta_star",
+            format!("{:.6e}", r.beta_star),
+            "Thm 4.3: 1/(2d)",
+        ),
+        ("required_v", format!("{:.6e}", r.required_v), "(4.13)"),
+        ("required_w", format!("{:.6e}", r.required_w), "(4.14)"),
+    ];
+    push_optional_rows(r, &mut rows);
     let mut out = String::new();
     for (name, value, cite) in rows {
         out.push_str(&format!("{name:<22} {value:>16}   {cite}\n"));
     }
     if let Some(c) = &r.certified {
-        out.push_str("certified enclosures [lo, hi] (outward-rounded):\n");
-        for (name, [lo, hi]) in &c.enclosures {
-            out.push_str(&format!("  {name:<20} [{lo:e}, {hi:e}]\n"));
-        }
-        out.push_str("certified steps:\n");
-        for (name, s) in &c.steps {
-            let step = s.step.map_or_else(|| "-".to_string(), |x| format!("{x:e}"));
-            let bound = s
-                .bound
-                .map_or_else(|| "-".to_string(), |[lo, hi]| format!("[{lo:e}, {hi:e}]"));
-            out.push_str(&format!(
-                "  {name:<20} {:<14} step {step}, bound {bound}\n",
-                s.outcome
-            ));
-        }
+        render_certified(c, &mut out);
     }
     out
+}
+
+/// The `certified` part of the table: the enclosures, then the certified steps.
+fn render_certified(c: &CertifiedReport, out: &mut String) {
+    out.push_str("certified enclosures [lo, hi] (outward-rounded):\n");
+    for (name, [lo, hi]) in &c.enclosures {
+        out.push_str(&format!("  {name:<20} [{lo:e}, {hi:e}]\n"));
+    }
+    out.push_str("certified steps:\n");
+    for (name, s) in &c.steps {
+        let step = s.step.map_or_else(|| "-".to_string(), |x| format!("{x:e}"));
+        let bound = s
+            .bound
+            .map_or_else(|| "-".to_string(), |[lo, hi]| format!("[{lo:e}, {hi:e}]"));
+        out.push_str(&format!(
+            "  {name:<20} {:<14} step {step}, bound {bound}\n",
+            s.outcome
+        ));
+    }
 }
 
 /// Runs `sepg bounds`.

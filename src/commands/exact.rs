@@ -1,12 +1,10 @@
 //! `sepg exact`: exact J and derivatives of a 1-D LQG preset — the closed form for the unclipped
-//! model (any horizon) or dynamic programming for the clipped model (finite horizon).
+//! model (any horizon) or dynamic programming for the clipped model (finite horizon); the
+//! work and the checks of the arguments are `sepg_runs::exact`, this file parses and prints.
 
 use clap::Args;
-use nalgebra::DVector;
-use sepg_mdp::LqgModel;
-use sepg_mdp::oracle::{
-    ClippedDpOracle, ClosedFormOracle, ExactEval, ExactOracle, Exploration, Horizon, OracleError,
-};
+use sepg_mdp::oracle::{ExactEval, Horizon};
+use sepg_runs::exact::{ExactSpec, exact};
 use serde::Serialize;
 
 use crate::cli::CliError;
@@ -61,65 +59,15 @@ struct ExactReport {
     hessian: Option<Vec<Vec<f64>>>,
 }
 
-/// Maps an oracle error to the CLI contract: input problems exit 2, numerical failures exit 1.
-fn oracle_error(e: OracleError) -> CliError {
-    match e {
-        OracleError::NotConverged { .. }
-        | OracleError::Overflow
-        | OracleError::ResolutionExceeded { .. } => CliError::failure(e.to_string()),
-        _ => CliError::usage(e.to_string()),
-    }
-}
-
 fn evaluate(args: &ExactArgs) -> Result<(ExactEval, Horizon), CliError> {
-    if !args.v.is_finite() {
-        return Err(CliError::usage(format!("v must be finite, got {}", args.v)));
-    }
-    if !(args.sigma.is_finite() && args.sigma >= 0.0) {
-        return Err(CliError::usage(format!(
-            "sigma must be finite and >= 0, got {}",
-            args.sigma
-        )));
-    }
-    if !(args.eta.is_finite() && args.eta >= 0.0) {
-        return Err(CliError::usage(format!(
-            "eta must be finite and >= 0, got {}",
-            args.eta
-        )));
-    }
-    let model: LqgModel = args
-        .env
-        .model()
-        .with_noise(DVector::from_element(1, args.eta))
-        .map_err(|e| CliError::usage(e.to_string()))?;
-    let exploration = if args.sigma == 0.0 {
-        Exploration::Deterministic
-    } else {
-        Exploration::Gaussian {
-            w: vec![args.sigma.ln()],
-        }
-    };
-    let horizon = match (args.horizon, args.clipped) {
-        (Some(h), _) => h.0,
-        (None, true) => Horizon::Finite(20),
-        (None, false) => Horizon::Infinite,
-    };
-    let eval = if args.clipped {
-        if horizon == Horizon::Infinite {
-            return Err(CliError::usage(
-                "the clipped model needs a finite --horizon",
-            ));
-        }
-        ClippedDpOracle::new(&model)
-            .map_err(oracle_error)?
-            .evaluate(&[args.v], &exploration, horizon)
-    } else {
-        ClosedFormOracle::new(&model)
-            .map_err(oracle_error)?
-            .evaluate(&[args.v], &exploration, horizon)
-    }
-    .map_err(oracle_error)?;
-    Ok((eval, horizon))
+    Ok(exact(&ExactSpec {
+        env: args.env.name().to_string(),
+        v: args.v,
+        sigma: args.sigma,
+        horizon: args.horizon.map(|h| h.0),
+        eta: args.eta,
+        clipped: args.clipped,
+    })?)
 }
 
 /// Runs `sepg exact`.

@@ -2,7 +2,6 @@
 
 use std::str::FromStr;
 
-use sepg_mdp::LqgModel;
 use sepg_mdp::oracle::Horizon;
 
 /// A 1-D LQG preset name.
@@ -20,14 +19,6 @@ impl LqgPreset {
         match self {
             LqgPreset::Lqg => "lqg",
             LqgPreset::Lqg1d => "lqg1d",
-        }
-    }
-
-    /// The preset's model.
-    pub fn model(self) -> LqgModel {
-        match self {
-            LqgPreset::Lqg => LqgModel::thesis(),
-            LqgPreset::Lqg1d => LqgModel::lqg1d(),
         }
     }
 }

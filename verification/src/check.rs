@@ -397,3 +397,22 @@ impl Check {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn relative_tolerance_scales_with_the_larger_magnitude_also_below_one() {
+        // abs + rel·max(|truth|, |claimed|), written out by hand. Magnitudes below 1 must not
+        // be floored at 1: the DP checks compare improvements of order 1e-6..1e-3.
+        let t = Tolerance {
+            abs: 1e-13,
+            rel: 1e-4,
+        };
+        assert_relative_eq!(t.allowed(1e-3, -2e-3), 1e-13 + 2e-7, max_relative = 1e-12);
+        assert_relative_eq!(t.allowed(0.0, 0.0), 1e-13, max_relative = 1e-12);
+        assert_relative_eq!(t.allowed(-50.0, 3.0), 1e-13 + 5e-3, max_relative = 1e-12);
+    }
+}

@@ -45,7 +45,7 @@ impl Comparison {
         }
     }
 
-    fn fails(&self, kind: ClaimKind, tol: Tolerance) -> bool {
+    pub(crate) fn fails(&self, kind: ClaimKind, tol: Tolerance) -> bool {
         let s = self.shortfall(kind);
         s.is_nan() || s > tol.allowed(self.truth, self.claimed)
     }
@@ -276,5 +276,29 @@ pub(crate) fn fixed(ctx: &CheckContext<'_>, comparisons: &[(String, Comparison)]
         outcome,
         cases: stats.cases,
         figures: common_figures(&stats, false),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_shortfall_beyond_the_relative_tolerance_fails() {
+        // Tolerance of the DP checks: 1e-13 + 1e-4·max(|truth|, |claimed|). A lower bound
+        // 2e-4 (relative) above a truth of 1e-3 falls short by 2e-7 > 1.0002e-7: it fails; one
+        // 5e-5 above falls short by 5e-8 < 1.00005e-7: it passes, and so does any claim below.
+        let tol = Tolerance {
+            abs: 1e-13,
+            rel: 1e-4,
+        };
+        let lower = ClaimKind::LowerBound;
+        assert!(Comparison::new(1e-3, 1e-3 * (1.0 + 2e-4)).fails(lower, tol));
+        assert!(!Comparison::new(1e-3, 1e-3 * (1.0 + 5e-5)).fails(lower, tol));
+        assert!(!Comparison::new(1e-3, 0.5e-3).fails(lower, tol));
+        assert!(Comparison::new(-1e-3, -1e-3 * (1.0 - 2e-4)).fails(lower, tol));
+        assert!(Comparison::new(1e-3, f64::NAN).fails(lower, tol));
+        assert!(Comparison::new(2e-3, 1e-3).fails(ClaimKind::UpperBound, tol));
+        assert!(Comparison::new(1e-3, 1e-3 * (1.0 + 2e-4)).fails(ClaimKind::Equality, tol));
     }
 }

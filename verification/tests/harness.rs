@@ -2,6 +2,7 @@
 //! Clopper–Pearson helper against a committed high-precision table, and the finite-MDP oracle
 //! against closed forms.
 
+use approx::{assert_abs_diff_eq, relative_eq};
 use sepg_verification::finite_mdp::{FiniteMdp, MdpError, TabularPolicy};
 use sepg_verification::stats::{StatsError, clopper_pearson_lower, clopper_pearson_upper};
 use sepg_verification::{BoundFns, Outcome, RunConfig, derive_seed, registry, run_checks};
@@ -209,9 +210,9 @@ fn v_step_c_halved(
     grad: &[f64],
     required: f64,
 ) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
-    // The safe interval of a bound with c/2 is the one of c for the doubled requirement,
-    // with steps doubled.
-    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, 2.0 * required)?;
+    // The safe interval of a bound with c/2 is the one of c for half the requirement, with
+    // steps doubled: (2α)n² − (2α)²(c/2)n² = 2(αn² − α²cn²).
+    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 2.0)?;
     Ok(match out {
         sepg_bounds::outcome::StepOutcome::Feasible(s) => {
             sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
@@ -234,6 +235,51 @@ fn v_bound_c_tiny(
 ) -> Result<f64, sepg_bounds::BoundsError> {
     let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
     Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1e-3)? * n * n)
+}
+
+/// The v-update bound with c/30 (the safe interval of c/30 is the one of c for 30 times the
+/// requirement, with steps times 30).
+fn v_bound_c_30(
+    k: &sepg_bounds::constants::TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+    alpha: f64,
+) -> Result<f64, sepg_bounds::BoundsError> {
+    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+    Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1.0 / 30.0)? * n * n)
+}
+
+fn v_step_c_30(
+    k: &sepg_bounds::constants::TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+    required: f64,
+) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
+    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 30.0)?;
+    Ok(match out {
+        sepg_bounds::outcome::StepOutcome::Feasible(s) => {
+            sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
+                c_max: 30.0 * s.c_max,
+                vertex: 30.0 * s.vertex,
+                lo: 30.0 * s.lo,
+                hi: 30.0 * s.hi,
+                ..s
+            })
+        }
+        other => other,
+    })
+}
+
+#[test]
+fn a_c_thirty_times_too_small_is_caught_against_the_true_j() {
+    // The control steps of thm-4.2-v-update (lqg at γ = 0, where the closed form predicts the
+    // violation) catch c/30 in the bound together with its safe interval.
+    let b = BoundFns {
+        v_update_bound: v_bound_c_30,
+        v_safe_step: v_step_c_30,
+        ..BoundFns::default()
+    };
+    assert_eq!(run_broken("thm-4.2-v-update", b), ("violated", false));
 }
 
 #[test]
@@ -310,11 +356,11 @@ fn clopper_pearson_matches_the_mpmath_table() {
         // statrs' continued fraction for I_x(a, b) is accurate to ~1e-13 relative; 1e-9 leaves
         // room for large n (1e5 trials) where the Beta parameters are large.
         assert!(
-            (u - up).abs() <= 1e-9 * up.abs() + 1e-300,
+            relative_eq!(u, up, epsilon = 1e-300, max_relative = 1e-9),
             "upper {line}: {u}"
         );
         assert!(
-            (l - lo).abs() <= 1e-9 * lo.abs() + 1e-300,
+            relative_eq!(l, lo, epsilon = 1e-300, max_relative = 1e-9),
             "lower {line}: {l}"
         );
         rows += 1;
@@ -359,22 +405,34 @@ fn finite_mdp_matches_closed_forms() {
     let mdp = two_state(x, y, z, gamma);
     let stay = TabularPolicy::new(2, 2, vec![1.0, 0.0, 1.0, 0.0]).unwrap();
     let e = mdp.evaluate(&stay).unwrap();
-    assert!((e.j() - x / (1.0 - gamma)).abs() < 1e-12);
+    assert_abs_diff_eq!(e.j(), x / (1.0 - gamma), epsilon = 1e-12);
     let advantage = y + gamma * z / (1.0 - gamma) - x / (1.0 - gamma);
-    assert!((e.advantage(0, 1) - advantage).abs() < 1e-12);
+    assert_abs_diff_eq!(e.advantage(0, 1), advantage, epsilon = 1e-12);
     let greedy = e.greedy();
     assert_eq!(greedy.prob(0, 1), 1.0);
-    assert!((e.policy_advantage(&greedy) - advantage).abs() < 1e-12);
+    assert_abs_diff_eq!(e.policy_advantage(&greedy), advantage, epsilon = 1e-12);
     // Mixture: leave with probability α; d(0) = (1−γ)/(1−γ(1−α)), ΔJ = αA/(1−γ(1−α)).
     let mix = stay.mixture(&greedy, alpha).unwrap();
     let em = mdp.evaluate(&mix).unwrap();
     let d0 = (1.0 - gamma) / (1.0 - gamma * (1.0 - alpha));
-    assert!((em.state_distribution()[0] - d0).abs() < 1e-12);
-    assert!((em.state_distribution().iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    assert_abs_diff_eq!(em.state_distribution()[0], d0, epsilon = 1e-12);
+    assert_abs_diff_eq!(
+        em.state_distribution().iter().sum::<f64>(),
+        1.0,
+        epsilon = 1e-12
+    );
     let gain = alpha * advantage / (1.0 - gamma * (1.0 - alpha));
-    assert!((em.j() - e.j() - gain).abs() < 1e-12);
-    assert!((stay.sup_l1_distance(&mix).unwrap() - 2.0 * alpha).abs() < 1e-15);
-    assert!((mdp.discounted_sum_along(&stay, &[1.0, 0.0]).unwrap() - 10.0).abs() < 1e-9);
+    assert_abs_diff_eq!(em.j() - e.j(), gain, epsilon = 1e-12);
+    assert_abs_diff_eq!(
+        stay.sup_l1_distance(&mix).unwrap(),
+        2.0 * alpha,
+        epsilon = 1e-15
+    );
+    assert_abs_diff_eq!(
+        mdp.discounted_sum_along(&stay, &[1.0, 0.0]).unwrap(),
+        10.0,
+        epsilon = 1e-9
+    );
 }
 
 #[test]
@@ -386,7 +444,7 @@ fn thm_3_2_counterexample_in_closed_form() {
     let e = mdp.evaluate(&stay).unwrap();
     let greedy = e.greedy();
     let adv = e.policy_advantage(&greedy);
-    assert!((adv - 2.0 * r / (1.0 - gamma)).abs() < 1e-12);
+    assert_abs_diff_eq!(adv, 2.0 * r / (1.0 - gamma), epsilon = 1e-12);
     let alpha = (1.0 - gamma) * adv / (4.0 * r);
     let gain = mdp
         .evaluate(&stay.mixture(&greedy, alpha).unwrap())
@@ -394,7 +452,7 @@ fn thm_3_2_counterexample_in_closed_form() {
         .j()
         - e.j();
     // 𝔸 = 20, α* = 1/2: ΔJ = α𝔸/(1 − γ(1 − α)) = 10/0.55 while 𝔸²/(8R) = 50.
-    assert!((gain - 10.0 / 0.55).abs() < 1e-9);
+    assert_abs_diff_eq!(gain, 10.0 / 0.55, epsilon = 1e-9);
     assert!(gain < adv * adv / (8.0 * r) - 30.0);
 }
 

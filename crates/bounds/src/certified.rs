@@ -16,6 +16,13 @@
 //! any form into a [`Certified`] outcome, so a new step form is certified by implementing the
 //! trait for its bound.
 //!
+//! The step functions below first try a cheaper certificate: the bound evaluated in plain
+//! `f64` with an a-priori bound on its rounding error (standard model of floating-point
+//! arithmetic, γ_k = k·u/(1 − k·u); the analysis is in docs/THEOREMS.md, "Certified steps"),
+//! and fall back to interval arithmetic when that analysis does not apply or does not certify
+//! a step ([`CertifiedStep::by_error_bound`] says which). The rigorous forms and
+//! [`adaptive_step`] use interval arithmetic only.
+//!
 //! | function | bound | thesis |
 //! |---|---|---|
 //! | [`v_safe_step`] | α‖∇_vJ‖∞² − α²c‖∇_vJ‖∞² | Theorem 4.2 |
@@ -23,13 +30,17 @@
 //! | [`w_safe_step_along_l`] | β∇_wL∇_wJ − β²d(∇_wL)² | Theorem 4.5 |
 //! | [`hp_v_safe_step`], [`hp_w_safe_step_along_j`], [`hp_w_safe_step_along_l`] | high-probability forms | Theorems 4.7–4.9 |
 //! | [`rigorous_safe_step_along_j`], [`rigorous_safe_step_along_l`] | rigorous w-bound | [`crate::rigorous`] |
+//! | [`exploring_safe_step`] | Δw·∇̂_wJ − \|Δw\|·ε_J − d(σ)Δw² | docs/THEOREMS.md, Theorem E |
+//! | [`adaptive_step`] | α‖∇J‖₂² − α²c(σ)‖∇J‖₁² (guarantee only) | Theorem 3.10, Corollary 3.11 |
 
-use crate::constants::TaskConstants;
+use crate::constants::{self, TaskConstants};
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, non_negative, positive};
+use crate::exploring::ExploringBound;
 use crate::high_probability::{self as hp, HpForm};
 use crate::interval::{Interval, from_ordered_key, ordered_key};
 use crate::outcome::{SafeInterval, StepOutcome};
-use crate::{rigorous, v_update, w_update};
+use crate::rounding::{self, Parabola, Rounded, RoundedBound};
+use crate::{pirotta, rigorous, v_update, w_update};
 
 /// Ulps walked one at a time around the predicted move before bisecting or doubling.
 const LOCAL_STEPS: u64 = 4;
@@ -503,14 +514,9 @@ impl EnclosedBound for RigorousEnclosure {
         }
         let dw = Interval::point(beta).scale(self.direction);
         let curvature = Interval::point(1.0).max((-dw).exp());
-        let (m_lo, m_hi) = if dw.lo() >= 0.0 {
-            (dw.lo(), dw.hi())
-        } else if dw.hi() <= 0.0 {
-            (-dw.hi(), -dw.lo())
-        } else {
-            (0.0, dw.lo().abs().max(dw.hi()))
-        };
-        let kl = Interval::new(kl2_at(m_lo).lo(), kl2_at(m_hi).hi()).unwrap_or(Interval::ENTIRE);
+        let m = dw.abs();
+        let kl =
+            Interval::new(kl2_at(m.lo()).lo(), kl2_at(m.hi()).hi()).unwrap_or(Interval::ENTIRE);
         let coefficient = (self.a * curvature).max(self.a_line);
         dw.scale(self.slope) - coefficient * dw.sqr() - self.g * kl
     }
@@ -527,6 +533,10 @@ pub struct CertifiedStep {
     pub ulps_moved: u64,
     /// The safe interval computed in `f64` (λ, C_max and end points as computed).
     pub interval: SafeInterval,
+    /// Whether the certificate came from the a-priori rounding-error bound of the `f64`
+    /// evaluation (the fast path) rather than from interval arithmetic (docs/THEOREMS.md,
+    /// "Certified steps").
+    pub by_error_bound: bool,
 }
 
 /// The outcome of a certified safe-step computation.
@@ -625,6 +635,7 @@ pub fn certify<B: EnclosedBound + ?Sized>(
                 bound: enclosure,
                 ulps_moved,
                 interval: s,
+                by_error_bound: false,
             }),
             Err(enclosure) => Certified::Uncertifiable {
                 step: s.vertex,
@@ -740,6 +751,108 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
     Ok((at(good), good_enclosure, good))
 }
 
+/// Certifies `outcome` with the fast a-priori enclosure `fast` (module `rounding`) when it
+/// applies and certifies a step, and otherwise with the interval enclosure `interval` (`None`:
+/// below noise). The body shared by every certified step form.
+fn certify_fast_then_interval<S: EnclosedBound>(
+    outcome: StepOutcome,
+    required: f64,
+    fast: impl FnOnce() -> Option<RoundedBound>,
+    interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
+) -> Result<Certified, BoundsError> {
+    match outcome {
+        StepOutcome::ZeroGradient { requirement_met } => {
+            return Ok(Certified::ZeroGradient { requirement_met });
+        }
+        StepOutcome::BelowNoise => return Ok(Certified::BelowNoise),
+        StepOutcome::Feasible(_) | StepOutcome::Infeasible { .. } => {}
+    }
+    if let Some(certified) = fast().and_then(|bound| certify_predicted(&bound, outcome, required)) {
+        return Ok(certified);
+    }
+    Ok(match interval()? {
+        Some(bound) => certify(&bound, outcome, required),
+        None => Certified::BelowNoise,
+    })
+}
+
+/// The error-bound path of [`certify_fast_then_interval`]: the largest safe step `hi` when
+/// its enclosure passes, else `hi` moved toward the vertex by the number of ulps that the
+/// bound's slope predicts for the shortfall, enlarged by 1/8 and 2 ulps, when that passes (two
+/// evaluations and no search). The error-bound enclosure is wider than the interval one, so
+/// the move is longer than the interval path's (about twice as many ulps, ≲ 1e-14 relative).
+/// `None` when neither passes: the caller then searches in interval arithmetic.
+fn certify_predicted(
+    bound: &RoundedBound,
+    outcome: StepOutcome,
+    required: f64,
+) -> Option<Certified> {
+    let s = match outcome {
+        StepOutcome::Feasible(s) => s,
+        StepOutcome::Infeasible { vertex, .. } => {
+            return Some(Certified::Infeasible {
+                step: vertex,
+                bound: bound.enclose(vertex),
+            });
+        }
+        StepOutcome::ZeroGradient { .. } | StepOutcome::BelowNoise => return None,
+    };
+    let first = bound.enclose(s.hi);
+    let (step, enclosure, ulps_moved) = if first.lo() >= required {
+        (s.hi, first, 0)
+    } else {
+        let (start, end) = (ordered_key(s.hi), ordered_key(s.vertex));
+        let toward = |n: u64| {
+            let n = n as i64;
+            from_ordered_key(if end < start { start - n } else { start + n })
+        };
+        let ulp = (toward(1) - s.hi).abs();
+        let predicted = (required - first.lo()) / (bound.slope(s.hi)?.abs() * ulp);
+        // 2⁵² bounds the cast below; NaN is rejected too
+        if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
+            return None;
+        }
+        let n = (predicted.max(0.0) * 1.125 + 2.0) as u64;
+        if n > end.abs_diff(start) {
+            return None;
+        }
+        let x = toward(n);
+        let e = bound.enclose(x);
+        if e.lo() < required {
+            return None;
+        }
+        (x, e, n)
+    };
+    Some(Certified::Step(CertifiedStep {
+        step,
+        bound: enclosure,
+        ulps_moved,
+        interval: s,
+        by_error_bound: true,
+    }))
+}
+
+/// The parabola a·x − b·x² with a = g², b = k·g² (Theorems 4.2, 4.3) in rounded `f64`.
+fn squared_parabola(g: f64, k: Option<Rounded>) -> Option<RoundedBound> {
+    let g = Rounded::exact(g);
+    let a = g.mul(g)?;
+    Some(RoundedBound::parabola(a, k?.mul(a)?))
+}
+
+/// The high-probability bound with s = +1, a^∓ = (n ∓ ε)², b = k·a⁺ (Theorems 4.7, 4.8) in
+/// rounded `f64`; only called when n > ε.
+fn corrected_parabola(n: f64, eps: f64, k: Option<Rounded>, form: HpForm) -> Option<RoundedBound> {
+    let (lower, upper) = (Rounded::difference(n, eps), Rounded::sum(n, eps));
+    let upper2 = upper.mul(upper)?;
+    Some(RoundedBound::high_probability(
+        1.0,
+        lower.mul(lower)?,
+        upper2,
+        k?.mul(upper2)?,
+        form,
+    ))
+}
+
 /// Certified safe v-step of Theorem 4.2 (eq. (4.10)) for the requirement C.
 ///
 /// # Formula
@@ -764,12 +877,16 @@ pub fn v_safe_step(
     grad_v: &[f64],
     required: f64,
 ) -> Result<Certified, BoundsError> {
-    let outcome = v_update::safe_step(k, sigma, grad_v, required)?;
-    Ok(certify(
-        &Quadratic::v_update(k, sigma, grad_v)?,
+    finite_vector("grad_v", grad_v)?;
+    finite("required", required)?;
+    let cc = constants::c(k, sigma)?;
+    let outcome = v_update::safe_step_with_c(cc, grad_v, required)?;
+    certify_fast_then_interval(
         outcome,
         required,
-    ))
+        || squared_parabola(inf_norm(grad_v), rounding::c(k, sigma, cc)),
+        || Quadratic::v_update(k, sigma, grad_v).map(Some),
+    )
 }
 
 /// Certified safe steps along ∇_w J, Theorem 4.3 (eq. (4.17)).
@@ -786,12 +903,16 @@ pub fn w_safe_step_along_j(
     grad_w_j: f64,
     required: f64,
 ) -> Result<Certified, BoundsError> {
-    let outcome = w_update::safe_step_along_j(k, sigma, grad_w_j, required)?;
-    Ok(certify(
-        &Quadratic::w_along_j(k, sigma, grad_w_j)?,
+    finite("grad_w_j", grad_w_j)?;
+    finite("required", required)?;
+    let dd = constants::d(k, sigma)?;
+    let outcome = w_update::safe_step_along_j_with_d(dd, grad_w_j, required)?;
+    certify_fast_then_interval(
         outcome,
         required,
-    ))
+        || squared_parabola(grad_w_j, rounding::d(k, sigma, dd)),
+        || Quadratic::w_along_j(k, sigma, grad_w_j).map(Some),
+    )
 }
 
 /// Certified safe steps along ∇_w L, Theorem 4.5 (eq. (4.19)).
@@ -810,20 +931,19 @@ pub fn w_safe_step_along_l(
     grad_w_l: f64,
     required: f64,
 ) -> Result<Certified, BoundsError> {
-    let outcome = w_update::safe_step_along_l(k, sigma, grad_w_j, grad_w_l, required)?;
-    Ok(certify(
-        &Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l)?,
-        outcome,
-        required,
-    ))
-}
-
-/// Certifies a high-probability outcome, or passes `BelowNoise` through.
-fn certify_hp(enclosure: Option<HpEnclosure>, outcome: StepOutcome, required: f64) -> Certified {
-    match enclosure {
-        Some(e) => certify(&e, outcome, required),
-        None => Certified::BelowNoise,
-    }
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("required", required)?;
+    let dd = constants::d(k, sigma)?;
+    let outcome = w_update::safe_step_along_l_with_d(dd, grad_w_j, grad_w_l, required)?;
+    let fast = || {
+        let (j, l) = (Rounded::exact(grad_w_j), Rounded::exact(grad_w_l));
+        let b = rounding::d(k, sigma, dd)?.mul(l.mul(l)?)?;
+        Some(RoundedBound::parabola(l.mul(j)?, b))
+    };
+    certify_fast_then_interval(outcome, required, fast, || {
+        Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l).map(Some)
+    })
 }
 
 /// Certified high-probability v-step, Theorem 4.7 (eq. (4.26)), in the form `form`.
@@ -842,9 +962,18 @@ pub fn hp_v_safe_step(
     required: f64,
     form: HpForm,
 ) -> Result<Certified, BoundsError> {
-    let outcome = hp::v_safe_step(k, sigma, grad_v_hat, eps, required, form)?;
-    let enclosure = HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form)?;
-    Ok(certify_hp(enclosure, outcome, required))
+    finite("required", required)?;
+    let cc = constants::c(k, sigma)?;
+    let outcome = match hp::HighProbabilityBound::v_update_with_c(cc, grad_v_hat, eps)? {
+        Some(b) => b.safe_step(required, form)?,
+        None => StepOutcome::BelowNoise,
+    };
+    certify_fast_then_interval(
+        outcome,
+        required,
+        || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form),
+        || HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form),
+    )
 }
 
 /// Certified high-probability step along ∇̂_w J, Theorem 4.8 (eq. (4.29)).
@@ -865,8 +994,15 @@ pub fn hp_w_safe_step_along_j(
     form: HpForm,
 ) -> Result<Certified, BoundsError> {
     let outcome = hp::w_safe_step_along_j(k, sigma, grad_w_j_hat, eps, required, form)?;
-    let enclosure = HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form)?;
-    Ok(certify_hp(enclosure, outcome, required))
+    certify_fast_then_interval(
+        outcome,
+        required,
+        || {
+            let dd = rounding::d(k, sigma, constants::d(k, sigma).ok()?);
+            corrected_parabola(grad_w_j_hat.abs(), eps, dd, form)
+        },
+        || HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form),
+    )
 }
 
 /// Certified high-probability step along ∇̂_w L, Theorem 4.9 (eq. (4.30)); the estimates
@@ -890,11 +1026,28 @@ pub fn hp_w_safe_step_along_l(
     let (j, ej) = grad_w_j_hat;
     let (l, el) = grad_w_l_hat;
     let outcome = hp::w_safe_step_along_l(k, sigma, j, ej, l, el, required, form)?;
-    let enclosure = HpEnclosure::w_along_l(k, sigma, grad_w_j_hat, grad_w_l_hat, form)?;
-    Ok(certify_hp(enclosure, outcome, required))
+    let fast = || {
+        let (nj, nl) = (j.abs(), l.abs());
+        let (l_hi, j_hi) = (Rounded::sum(nl, el), Rounded::sum(nj, ej));
+        let lower = Rounded::difference(nl, el).mul(Rounded::difference(nj, ej))?;
+        let dd = rounding::d(k, sigma, constants::d(k, sigma).ok()?)?;
+        let b = dd.mul(l_hi.mul(l_hi)?)?;
+        let direction = if (j > 0.0) == (l > 0.0) { 1.0 } else { -1.0 };
+        Some(RoundedBound::high_probability(
+            direction,
+            lower,
+            l_hi.mul(j_hi)?,
+            b,
+            form,
+        ))
+    };
+    certify_fast_then_interval(outcome, required, fast, || {
+        HpEnclosure::w_along_l(k, sigma, grad_w_j_hat, grad_w_l_hat, form)
+    })
 }
 
-/// Certified rigorous steps along ∇_w J ([`rigorous::safe_step_along_j`]).
+/// Certified rigorous steps along ∇_w J ([`rigorous::safe_step_along_j`]); interval
+/// arithmetic only (the bound involves e^x).
 ///
 /// ```
 /// use sepg_bounds::{certified, constants::TaskConstants};
@@ -909,11 +1062,16 @@ pub fn rigorous_safe_step_along_j(
     required: f64,
 ) -> Result<Certified, BoundsError> {
     let outcome = rigorous::safe_step_along_j(k, sigma, grad_w_j, required)?;
-    let enclosure = RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_j)?;
-    Ok(certify(&enclosure, outcome, required))
+    certify_fast_then_interval(
+        outcome,
+        required,
+        || None,
+        || RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_j).map(Some),
+    )
 }
 
-/// Certified rigorous steps along ∇_w L ([`rigorous::safe_step_along_l`]).
+/// Certified rigorous steps along ∇_w L ([`rigorous::safe_step_along_l`]); interval
+/// arithmetic only.
 ///
 /// ```
 /// use sepg_bounds::{certified, constants::TaskConstants};
@@ -930,8 +1088,12 @@ pub fn rigorous_safe_step_along_l(
     required: f64,
 ) -> Result<Certified, BoundsError> {
     let outcome = rigorous::safe_step_along_l(k, sigma, grad_w_j, grad_w_l, required)?;
-    let enclosure = RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_l)?;
-    Ok(certify(&enclosure, outcome, required))
+    certify_fast_then_interval(
+        outcome,
+        required,
+        || None,
+        || RigorousEnclosure::new(k, sigma, grad_w_j, grad_w_l).map(Some),
+    )
 }
 
 /// The bound of the exploring w-update (`crate::exploring`) as a function of the step size β
@@ -979,14 +1141,7 @@ impl ExploringEnclosure {
 impl EnclosedBound for ExploringEnclosure {
     fn enclose(&self, x: f64) -> Interval {
         let dw = Interval::point(x).scale(self.grad_w_l_hat);
-        let abs = if dw.lo() >= 0.0 {
-            dw
-        } else if dw.hi() <= 0.0 {
-            -dw
-        } else {
-            Interval::new(0.0, dw.hi().max(-dw.lo())).unwrap_or(dw)
-        };
-        dw.scale(self.grad_w_j_hat) - abs.scale(self.eps_j) - self.d * dw.sqr()
+        dw.scale(self.grad_w_j_hat) - dw.abs().scale(self.eps_j) - self.d * dw.sqr()
     }
 
     fn slope(&self, x: f64) -> Option<f64> {
@@ -1015,8 +1170,127 @@ pub fn exploring_safe_step(
     grad_w_l_hat: f64,
     required: f64,
 ) -> Result<Certified, BoundsError> {
-    let outcome =
-        crate::exploring::w_exploring_step(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, required)?;
-    let enclosure = ExploringEnclosure::new(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat)?;
-    Ok(certify(&enclosure, outcome, required))
+    let bound = ExploringBound::new(k, sigma, grad_w_j_hat, eps_j)?;
+    let outcome = bound.step_along(grad_w_l_hat, required)?;
+    let fast = || {
+        // in β (Δw = β·l): a = l·(j − sign(l)·ε) for β ≥ 0, l·(j + sign(l)·ε) for β < 0,
+        // b = d·l²
+        let l = Rounded::exact(grad_w_l_hat);
+        let (toward, against) = (
+            Rounded::difference(grad_w_j_hat, eps_j),
+            Rounded::sum(grad_w_j_hat, eps_j),
+        );
+        let (pos, neg) = if grad_w_l_hat > 0.0 {
+            (toward, against)
+        } else {
+            (against, toward)
+        };
+        let b = rounding::d(k, sigma, bound.d)?.mul(l.mul(l)?)?;
+        Some(RoundedBound::two_sided(
+            Parabola::new(l.mul(pos)?, b),
+            Parabola::new(l.mul(neg)?, b),
+        ))
+    };
+    certify_fast_then_interval(outcome, required, fast, || {
+        ExploringEnclosure::new(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat).map(Some)
+    })
+}
+
+/// The adaptive step of Pirotta et al. with fixed σ (Corollary 3.11, the step of the
+/// AdaStep comparison algorithm) with a certified guarantee: the step is α* of
+/// [`pirotta::optimal_step`], and `bound` encloses the Theorem 3.10 bound at that `f64` α*,
+/// so `bound.lo()` is a guarantee that holds in exact arithmetic (the `f64` guarantee α*‖∇‖₂²/2
+/// can exceed it by rounding).
+///
+/// # Formula
+///
+/// ```text
+/// B(α) = α ‖∇J‖₂² − α² c(σ) ‖∇J‖₁²,   α* = ‖∇J‖₂² / (2 c(σ) ‖∇J‖₁²)
+/// ```
+///
+/// Outcomes: [`Certified::Step`] with `ulps_moved` 0 and the degenerate `interval` [α*, α*]
+/// whose `c_max` is the `f64` guarantee; [`Certified::ZeroGradient`] for ∇J = 0. There is no
+/// requirement to certify: the guarantee is whatever the step attains.
+///
+/// ```
+/// use sepg_bounds::{certified, constants::TaskConstants, pirotta};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let o = certified::adaptive_step(&k, 1.0, &[0.3, -0.5])?;
+/// let b = o.bound().unwrap();
+/// assert!(b.lo() <= pirotta::bound(&k, 1.0, &[0.3, -0.5], o.chosen_step().unwrap())?);
+/// assert!(b.lo() > 0.0 && b.width() < 1e-15);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn adaptive_step(
+    k: &TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+) -> Result<Certified, BoundsError> {
+    let (alpha, guarantee) = match pirotta::optimal_step(k, sigma, grad)? {
+        pirotta::AdaptiveStep::Step { alpha, guarantee } => (alpha, guarantee),
+        pirotta::AdaptiveStep::ZeroGradient => {
+            return Ok(Certified::ZeroGradient {
+                requirement_met: true,
+            });
+        }
+        _ => return Ok(Certified::BelowNoise),
+    };
+    let (l2, l1) = grad.iter().fold(
+        (Interval::point(0.0), Interval::point(0.0)),
+        |(l2, l1), &g| (l2 + Interval::point(g).sqr(), l1 + Interval::point(g.abs())),
+    );
+    let bound = Quadratic {
+        linear: l2,
+        quadratic: c(k, sigma)? * l1.sqr(),
+    }
+    .enclose(alpha);
+    Ok(Certified::Step(CertifiedStep {
+        step: alpha,
+        bound,
+        ulps_moved: 0,
+        interval: SafeInterval {
+            c_max: guarantee,
+            vertex: alpha,
+            lambda: Some(0.0),
+            lo: alpha,
+            hi: alpha,
+        },
+        by_error_bound: false,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_error_bound_certifies_ordinary_steps_and_intervals_the_rest() {
+        let k = TaskConstants::new(0.99, 28.8, 4.0, 8.0).expect("lqg1d constants");
+        let Ok(Certified::Step(s)) = v_safe_step(&k, 0.5, &[-3.7], 0.0) else {
+            panic!("certified")
+        };
+        assert!(s.by_error_bound && s.bound.lo() >= 0.0 && s.ulps_moved > 0);
+        // σ below 2⁻¹⁰⁰: the rounding analysis of c does not apply
+        let Ok(Certified::Step(s)) = v_safe_step(&k, 1e-31, &[1e-60], 0.0) else {
+            panic!("certified")
+        };
+        assert!(!s.by_error_bound && s.bound.lo() >= 0.0);
+        // the same step form certified both ways meets C both ways
+        let cmax = v_update::c_max(&k, 0.5, &[-3.7]).expect("finite");
+        for required in [0.5 * cmax, -cmax] {
+            let fast = v_safe_step(&k, 0.5, &[-3.7], required).expect("valid");
+            let outcome = v_update::safe_step(&k, 0.5, &[-3.7], required).expect("valid");
+            let q = Quadratic::v_update(&k, 0.5, &[-3.7]).expect("valid");
+            let slow = certify(&q, outcome, required);
+            let (Certified::Step(f), Certified::Step(s)) = (fast, slow) else {
+                panic!("both certified")
+            };
+            assert!(f.by_error_bound && !s.by_error_bound);
+            assert!(f.bound.lo() >= required && s.bound.lo() >= required);
+            // the predicted move is at most 1/8 longer than the fewest ulps, plus 2
+            // the error bound is wider (about (k+7)u per term, k ≤ 18) than the interval
+            // enclosure, so its step moves further in, but by a negligible amount
+            assert!((f.step - s.step).abs() <= 1e-13 * s.step.abs());
+        }
+    }
 }

@@ -217,29 +217,40 @@ pub fn w_exploring_step(
     required: f64,
 ) -> Result<StepOutcome, BoundsError> {
     let bound = ExploringBound::new(k, sigma, grad_w_j_hat, eps_j)?;
-    finite("grad_w_l_hat", grad_w_l_hat)?;
-    finite("required", required)?;
-    if grad_w_l_hat == 0.0 {
-        return Ok(StepOutcome::ZeroGradient {
-            requirement_met: required <= 0.0,
-        });
-    }
-    let to_beta = |dw: f64| no_overflow("step size beta", dw / grad_w_l_hat);
-    Ok(match bound.safe_interval(required)? {
-        StepOutcome::Feasible(s) => {
-            let (a, b) = (to_beta(s.lo)?, to_beta(s.hi)?);
-            StepOutcome::Feasible(SafeInterval {
-                c_max: s.c_max,
-                vertex: to_beta(s.vertex)?,
-                lambda: None,
-                lo: a.min(b),
-                hi: a.max(b),
-            })
+    bound.step_along(grad_w_l_hat, required)
+}
+
+impl ExploringBound {
+    /// The exploring step along ∇̂_w L for this bound: the body of [`w_exploring_step`].
+    pub(crate) fn step_along(
+        &self,
+        grad_w_l_hat: f64,
+        required: f64,
+    ) -> Result<StepOutcome, BoundsError> {
+        finite("grad_w_l_hat", grad_w_l_hat)?;
+        finite("required", required)?;
+        if grad_w_l_hat == 0.0 {
+            return Ok(StepOutcome::ZeroGradient {
+                requirement_met: required <= 0.0,
+            });
         }
-        StepOutcome::Infeasible { c_max, vertex } => StepOutcome::Infeasible {
-            c_max,
-            vertex: to_beta(vertex)?,
-        },
-        other => other,
-    })
+        let to_beta = |dw: f64| no_overflow("step size beta", dw / grad_w_l_hat);
+        Ok(match self.safe_interval(required)? {
+            StepOutcome::Feasible(s) => {
+                let (a, b) = (to_beta(s.lo)?, to_beta(s.hi)?);
+                StepOutcome::Feasible(SafeInterval {
+                    c_max: s.c_max,
+                    vertex: to_beta(s.vertex)?,
+                    lambda: None,
+                    lo: a.min(b),
+                    hi: a.max(b),
+                })
+            }
+            StepOutcome::Infeasible { c_max, vertex } => StepOutcome::Infeasible {
+                c_max,
+                vertex: to_beta(vertex)?,
+            },
+            other => other,
+        })
+    }
 }

@@ -110,7 +110,15 @@ impl HighProbabilityBound {
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        let cc = c(k, sigma)?;
+        Self::v_update_with_c(c(k, sigma)?, grad_v_hat, eps)
+    }
+
+    /// [`Self::v_update`] for a given c(σ).
+    pub(crate) fn v_update_with_c(
+        cc: f64,
+        grad_v_hat: &[f64],
+        eps: f64,
+    ) -> Result<Option<Self>, BoundsError> {
         let Some(n) = corrected_norm(grad_v_hat, eps)? else {
             return Ok(None);
         };

@@ -91,7 +91,9 @@ impl Interval {
         (lo <= hi).then_some(Self { lo, hi })
     }
 
-    /// [lo, hi] for end points known to be ordered and not NaN (constants of the crate).
+    /// [lo, hi] for end points known to be ordered and not NaN (constants of the crate, and
+    /// end points whose rounding the caller has bounded).
+    #[inline]
     pub(crate) const fn from_sorted(lo: f64, hi: f64) -> Self {
         Self { lo, hi }
     }
@@ -246,6 +248,35 @@ impl Interval {
         } else {
             Self::rounded(self.hi * x, self.lo * x)
         }
+    }
+
+    /// The enclosure of |x| (exact end points).
+    ///
+    /// ```
+    /// use sepg_bounds::interval::Interval;
+    /// let a = Interval::new(-3.0, 2.0).unwrap().abs();
+    /// assert_eq!((a.lo(), a.hi()), (0.0, 3.0));
+    /// assert_eq!(Interval::new(-3.0, -2.0).unwrap().abs(), Interval::new(2.0, 3.0).unwrap());
+    /// ```
+    pub fn abs(self) -> Self {
+        if self.lo >= 0.0 {
+            self
+        } else if self.hi <= 0.0 {
+            -self
+        } else {
+            Self {
+                lo: 0.0,
+                hi: self.hi.max(-self.lo),
+            }
+        }
+    }
+
+    /// The interval [x − e, x + e] widened one ulp on each side, for a computed x and an error
+    /// bound e ≥ 0 with |exact − x| ≤ e (the roundings of x − e and x + e are covered by the
+    /// widening).
+    #[inline]
+    pub(crate) fn around(x: f64, e: f64) -> Self {
+        Self::rounded(x - e, x + e)
     }
 
     /// The convex hull of two intervals.

@@ -43,6 +43,7 @@ pub mod outcome;
 pub mod papini;
 pub mod pirotta;
 pub mod rigorous;
+mod rounding;
 pub mod surrogate;
 pub mod v_update;
 pub mod w_update;

@@ -54,8 +54,8 @@
 //! is an interval, found here by bisection inside closed-form brackets.
 
 use crate::constants::{TaskConstants, d, d_parts};
-use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow, positive};
-use crate::outcome::{SafeInterval, StepOutcome, solve_quadratic};
+use crate::error::{BoundsError, finite, finite_vector, no_overflow, positive};
+use crate::outcome::{SafeInterval, StepOutcome};
 
 /// √(2π).
 const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
@@ -160,12 +160,7 @@ pub fn v_bound(
 ) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("alpha", alpha)?;
-    let n = inf_norm(grad_v);
-    let n2 = no_overflow("||grad_v||^2", n * n)?;
-    no_overflow(
-        "rigorous v bound",
-        alpha * n2 - alpha * alpha * c(k, sigma)? * n2,
-    )
+    crate::v_update::bound_with_c(c(k, sigma)?, grad_v, alpha, "rigorous v bound")
 }
 
 /// The safe v-steps of Theorem 4.2 (eqs. (4.9)–(4.10)) with the sound [`c`]: vertex
@@ -193,10 +188,7 @@ pub fn v_safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    let cc = c(k, sigma)?;
-    let n = inf_norm(grad_v);
-    let n2 = no_overflow("||grad_v||^2", n * n)?;
-    solve_quadratic(n2, cc * n2, required)
+    crate::v_update::safe_step_with_c(c(k, sigma)?, grad_v, required)
 }
 
 /// Maximum number of bisection steps (enough to exhaust f64 precision from any finite bracket).

@@ -74,12 +74,20 @@ pub fn bound(
 ) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("alpha", alpha)?;
+    bound_with_c(c(k, sigma)?, grad_v, alpha, "Theorem 4.2 bound")
+}
+
+/// α‖∇_vJ‖∞² − α²·cc·‖∇_vJ‖∞² for a validated gradient and step and a penalty coefficient cc
+/// (the thesis's c or the sound c of [`crate::rigorous::c`]).
+pub(crate) fn bound_with_c(
+    cc: f64,
+    grad_v: &[f64],
+    alpha: f64,
+    quantity: &'static str,
+) -> Result<f64, BoundsError> {
     let n = inf_norm(grad_v);
     let n2 = no_overflow("||grad_v||^2", n * n)?;
-    no_overflow(
-        "Theorem 4.2 bound",
-        alpha * n2 - alpha * alpha * c(k, sigma)? * n2,
-    )
+    no_overflow(quantity, alpha * n2 - alpha * alpha * cc * n2)
 }
 
 /// The safe step sizes of Theorem 4.2 for a required improvement C (eq. (4.10)).
@@ -117,7 +125,16 @@ pub fn safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    let cc = c(k, sigma)?;
+    safe_step_with_c(c(k, sigma)?, grad_v, required)
+}
+
+/// The safe steps of eq. (4.10) for a validated gradient and requirement and a penalty
+/// coefficient cc: {α : α‖∇_vJ‖∞² − α²·cc·‖∇_vJ‖∞² ≥ C}.
+pub(crate) fn safe_step_with_c(
+    cc: f64,
+    grad_v: &[f64],
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
     let n = inf_norm(grad_v);
     let n2 = no_overflow("||grad_v||^2", n * n)?;
     solve_quadratic(n2, cc * n2, required)

@@ -104,7 +104,15 @@ pub fn safe_step_along_j(
 ) -> Result<StepOutcome, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
-    let dd = d(k, sigma)?;
+    safe_step_along_j_with_d(d(k, sigma)?, grad_w_j, required)
+}
+
+/// The safe steps of eq. (4.17) for validated inputs and a given d(σ).
+pub(crate) fn safe_step_along_j_with_d(
+    dd: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
     solve_quadratic(g2, dd * g2, required)
 }
@@ -210,7 +218,16 @@ pub fn safe_step_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
-    let dd = d(k, sigma)?;
+    safe_step_along_l_with_d(d(k, sigma)?, grad_w_j, grad_w_l, required)
+}
+
+/// The safe steps of eq. (4.19) for validated inputs and a given d(σ).
+pub(crate) fn safe_step_along_l_with_d(
+    dd: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
     let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
     let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
     solve_quadratic(lj, dd * l2, required)

@@ -185,10 +185,16 @@ impl Estimate {
     /// column's variance NaN or infinite (`∞ − ∞`, NaN propagation), so checking the mean and
     /// the variance also checks every sample.
     fn finish_variance(&mut self) -> Result<(), EstimatorError> {
-        self.variance.fill(0.0);
-        for row in self.samples.chunks_exact(self.dim) {
-            for ((v, x), c) in self.variance.iter_mut().zip(row).zip(&self.centre) {
-                *v += (x - c) * (x - c);
+        if self.dim == 1 {
+            // The same sum in the same order, without the per-row bookkeeping.
+            let c = self.centre[0];
+            self.variance[0] = self.samples.iter().fold(0.0, |v, x| v + (x - c) * (x - c));
+        } else {
+            self.variance.fill(0.0);
+            for row in self.samples.chunks_exact(self.dim) {
+                for ((v, x), c) in self.variance.iter_mut().zip(row).zip(&self.centre) {
+                    *v += (x - c) * (x - c);
+                }
             }
         }
         let inv_dof = 1.0 / (self.n as f64 - 1.0);
@@ -208,10 +214,15 @@ impl Estimate {
 
 /// Column means of a row-major `n × dim` matrix (`dim = out.len()`), summed in row order.
 fn column_means(samples: &[f64], n: usize, out: &mut [f64]) {
-    out.fill(0.0);
-    for row in samples.chunks_exact(out.len()) {
-        for (m, x) in out.iter_mut().zip(row) {
-            *m += x;
+    if let [m] = out {
+        // The same sum in the same order, without the per-row bookkeeping.
+        *m = samples.iter().fold(0.0, |m, x| m + x);
+    } else {
+        out.fill(0.0);
+        for row in samples.chunks_exact(out.len()) {
+            for (m, x) in out.iter_mut().zip(row) {
+                *m += x;
+            }
         }
     }
     let inv_n = 1.0 / n as f64;

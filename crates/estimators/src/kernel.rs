@@ -146,6 +146,14 @@ fn zeroed(v: &mut Vec<f64>, len: usize) {
     v.resize(len, 0.0);
 }
 
+/// Makes `v` at least `len` long; it never shrinks, so that blocks of alternating sizes do
+/// not refill it with zeros (every entry used is written before it is read).
+fn grow(v: &mut Vec<f64>, len: usize) {
+    if v.len() < len {
+        v.resize(len, 0.0);
+    }
+}
+
 impl Sums {
     /// Fits the baseline of `F` over `rows` trajectories of `width` entries with inputs
     /// `inputs`, and writes the samples (`comps` per trajectory, `width = steps · comps`) or
@@ -165,15 +173,16 @@ impl Sums {
         let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
         let keep_base = matches!(output, Output::Baselines);
         // Row r + 1 of `suf_num` receives trajectory r's sample terms (or baselines).
-        self.suf_num.resize((rows + 1) * w, 0.0);
+        let used = (rows + 1) * w;
+        grow(&mut self.suf_num, used);
         self.shared_base = false;
         match (baseline, fit) {
             (Baseline::None, _) => {
                 if keep_base {
-                    self.suf_num.fill(0.0);
+                    self.suf_num[..w].fill(0.0);
                     self.shared_base = true;
                 } else {
-                    for (r, p) in self.suf_num[w..].chunks_exact_mut(w).enumerate() {
+                    for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
                         let v = row(r);
                         for (e, p) in p.iter_mut().enumerate() {
                             *p = F::plain(std::array::from_fn(|k| v[k][e]));
@@ -200,7 +209,7 @@ impl Sums {
                     self.suf_num[..w].copy_from_slice(&self.pre_num);
                     self.shared_base = true;
                 } else {
-                    for (r, p) in self.suf_num[w..].chunks_exact_mut(w).enumerate() {
+                    for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
                         let v = row(r);
                         for (e, (p, b)) in p.iter_mut().zip(&self.pre_num).enumerate() {
                             *p = F::sample(std::array::from_fn(|k| v[k][e]), *b);
@@ -209,10 +218,10 @@ impl Sums {
                 }
             }
             (_, BaselineFit::LeaveOneOut) => {
-                self.suf_den.resize((rows + 1) * w, 0.0);
+                grow(&mut self.suf_den, used);
                 // Rows 0..rows are overwritten; row `rows` is the empty sum.
-                self.suf_num[rows * w..].fill(0.0);
-                self.suf_den[rows * w..].fill(0.0);
+                self.suf_num[rows * w..used].fill(0.0);
+                self.suf_den[rows * w..used].fill(0.0);
                 for r in (0..rows).rev() {
                     let v = row(r);
                     let (sn, sn_next) = self.suf_num[r * w..(r + 2) * w].split_at_mut(w);
@@ -226,9 +235,9 @@ impl Sums {
                 }
                 zeroed(&mut self.pre_num, w);
                 zeroed(&mut self.pre_den, w);
-                let others = self.suf_num[w..]
+                let others = self.suf_num[w..used]
                     .chunks_exact_mut(w)
-                    .zip(self.suf_den[w..].chunks_exact(w));
+                    .zip(self.suf_den[w..used].chunks_exact(w));
                 for (r, (on, od)) in others.enumerate() {
                     let v = row(r);
                     let pre = self.pre_num.iter_mut().zip(self.pre_den.iter_mut());
@@ -244,7 +253,7 @@ impl Sums {
             }
         }
         if let Output::Sums(out) = output {
-            let terms = &self.suf_num[w..];
+            let terms = &self.suf_num[w..used];
             if comps == 1 {
                 row_sums(&mut out[..rows], w, 0.0, [Rows::new(terms, w)], |[p]| p);
             } else {

@@ -1,5 +1,6 @@
 //! Estimators on tiny hand-made batches against values computed by hand.
 
+use approx::relative_eq;
 use sepg_estimators::{
     Baseline, BaselineFit, Estimate, Estimator, EstimatorError, GradientSpec, Kind, Param,
     SurrogateEstimate,
@@ -41,7 +42,7 @@ fn assert_close(got: &[f64], expected: &[f64]) {
     assert_eq!(got.len(), expected.len());
     for (g, e) in got.iter().zip(expected) {
         assert!(
-            (g - e).abs() <= 1e-14 * (1.0 + e.abs()),
+            relative_eq!(g, e, epsilon = 1e-14, max_relative = 1e-14),
             "{got:?} vs {expected:?}"
         );
     }

@@ -1,5 +1,6 @@
 //! Properties: estimators never return NaN for finite batches; the t-quantile is monotone.
 
+use approx::{abs_diff_eq, relative_eq};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use sepg_estimators::{
@@ -182,7 +183,7 @@ proptest! {
                     let scale = expected.iter().fold(1.0f64, |s, x| s.max(x.abs()));
                     for (g, e) in got.iter().zip(&expected) {
                         prop_assert!(
-                            (g - e).abs() <= 1e-9 * scale,
+                            abs_diff_eq!(*g, *e, epsilon = 1e-9 * scale),
                             "{target} {baseline:?} {fit:?}: {got:?} vs {expected:?}"
                         );
                     }
@@ -215,7 +216,7 @@ proptest! {
             est.gradient(&b, Param::V, GradientSpec { kind: Kind::Pgt, baseline, fit }, &mut q).unwrap();
             let scale = g.samples().iter().fold(1.0f64, |m, x| m.max(x.abs()));
             for (x, y) in g.samples().iter().zip(q.samples()) {
-                prop_assert!((x - y).abs() <= 1e-12 * scale * (h as f64), "{x} vs {y}");
+                prop_assert!(abs_diff_eq!(x, y, epsilon = 1e-12 * scale * (h as f64)), "{x} vs {y}");
             }
         }
     }
@@ -254,12 +255,12 @@ proptest! {
         let g = |t: f64| t + gamma * t * t / 3.0 + gamma * gamma * t.powi(3) / 27.0
             + gamma / (6.0 * n as f64);
         let y = student_t_quantile(1.0 - delta / 2.0, n as f64 - 1.0).unwrap() / (n as f64).sqrt();
-        prop_assert!((g((mean - lo[0]) / s) - y).abs() < 1e-9 * (1.0 + y), "lower end");
-        prop_assert!((g((mean - hi[0]) / s) + y).abs() < 1e-9 * (1.0 + y), "upper end");
+        prop_assert!(relative_eq!(g((mean - lo[0]) / s), y, epsilon = 1e-9, max_relative = 1e-9), "lower end");
+        prop_assert!(relative_eq!(g((mean - hi[0]) / s), -y, epsilon = 1e-9, max_relative = 1e-9), "upper end");
         let mut eps = [0.0];
         e.widths_into(Width::SkewCorrectedT, delta, &mut eps).unwrap();
         let enclosing = (mean - lo[0]).max(hi[0] - mean);
-        prop_assert!((eps[0] - enclosing).abs() <= 1e-14 * enclosing, "width");
+        prop_assert!(relative_eq!(eps[0], enclosing, epsilon = 0.0, max_relative = 1e-14), "width");
     }
 
     #[test]

@@ -18,8 +18,8 @@ use crate::env::{Environment, ScalarLqg};
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix};
 use crate::rollout::{
-    FusedPolicy, LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, Scratch, TrajSink, check,
-    kernel, scalar_kernel,
+    FusedPolicy, LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, ScoreAction, Scratch,
+    TrajSink, check, kernel, scalar_kernel,
 };
 
 /// A per-step baseline for each v- and w-component: `v[t·dim_v + k]`, `w[t·dim_w + j]`.
@@ -62,6 +62,7 @@ pub(crate) struct Streamer<'a, E: Environment + ?Sized> {
     policy: &'a GaussianPolicy,
     scalar: Option<(ScalarLqg, ScalarPolicy)>,
     fused: Option<FusedPolicy>,
+    score: ScoreAction,
     gamma: f64,
     limit: usize,
     horizon: usize,
@@ -69,12 +70,14 @@ pub(crate) struct Streamer<'a, E: Environment + ?Sized> {
 }
 
 impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
-    /// Checks the shapes (as [`crate::rollout::rollout`] does) and prepares the kernels.
+    /// Checks the shapes (as [`crate::rollout::rollout`] does) and prepares the kernels, whose
+    /// scores are evaluated at the action chosen by `score`.
     pub(crate) fn new(
         env: &'a E,
         policy: &'a GaussianPolicy,
         horizon: usize,
         key: SeedKey,
+        score: ScoreAction,
     ) -> Result<Self, RolloutError> {
         check(env, policy, 1, horizon)?;
         let (sigma, inv_sigma) = policy.sigma_raw();
@@ -84,12 +87,14 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                     v: policy.v()[0],
                     sigma: 0.0,
                     inv_sigma: 0.0,
+                    score,
                 }
             } else {
                 ScalarPolicy {
                     v: policy.v()[0],
                     sigma: sigma[0],
                     inv_sigma: inv_sigma[0],
+                    score,
                 }
             };
             (*p, pol)
@@ -98,7 +103,8 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             env,
             policy,
             scalar,
-            fused: FusedPolicy::of(env, policy),
+            fused: FusedPolicy::of(env, policy, score),
+            score,
             gamma: env.gamma(),
             limit: env.time_limit().map_or(horizon, |tl| tl.min(horizon)),
             horizon,
@@ -106,10 +112,15 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         })
     }
 
-    /// Work buffers for the generic kernel.
+    /// Work buffers for the generic kernel (empty, so not allocated, for the scalar LQG
+    /// kernel, which needs none).
     pub(crate) fn scratch(&self) -> Scratch {
         let e = self.env;
-        Scratch::new((e.state_dim(), e.action_dim(), e.feature_dim()))
+        if self.scalar.is_some() {
+            Scratch::new((0, 0, 0))
+        } else {
+            Scratch::new((e.state_dim(), e.action_dim(), e.feature_dim()))
+        }
     }
 
     /// Number of v-components `dim_v`.
@@ -147,6 +158,28 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         std::array::from_fn(|k| rngs_from_prefix(self.prefix, first + k as u64))
     }
 
+    /// Trajectory `index` through `sink` with the generic kernel (or the fused Mountain Car
+    /// one), then the steps `len .. horizon` after its end as padding (reward 0, scores frozen,
+    /// as in a [`crate::Batch`]). Returns `(len, G)`.
+    fn padded<S: TrajSink>(&self, index: u64, sink: &mut S, sc: &mut Scratch) -> (usize, f64) {
+        let mut rngs = rngs_from_prefix(self.prefix, index);
+        let (len, g) = kernel(
+            self.env,
+            self.policy,
+            self.fused,
+            self.score,
+            self.gamma,
+            self.limit,
+            &mut rngs,
+            sink,
+            sc,
+        );
+        for t in len..self.horizon {
+            sink.record(t, 0.0, &sc.cum_v, &sc.cum_w);
+        }
+        (len, g)
+    }
+
     /// The discounted returns of trajectories `first, first + 1, …` into `out`; returns the
     /// number of environment steps taken.
     pub(crate) fn returns(&self, first: u64, out: &mut [f64], sc: &mut Scratch) -> u64 {
@@ -158,17 +191,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             None => {
                 let mut steps = 0;
                 for (k, g) in out.iter_mut().enumerate() {
-                    let mut rngs = rngs_from_prefix(self.prefix, first + k as u64);
-                    let (len, ret) = kernel(
-                        self.env,
-                        self.policy,
-                        self.fused,
-                        self.gamma,
-                        self.limit,
-                        &mut rngs,
-                        &mut NoSteps,
-                        sc,
-                    );
+                    let (len, ret) = self.padded(first + k as u64, &mut NoSteps, sc);
                     *g = ret;
                     steps += len as u64;
                 }
@@ -212,7 +235,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         out: &mut [f64],
         sc: &mut Scratch,
     ) -> u64 {
-        let (dv, dw, h) = (self.dim_v(), self.dim_w(), self.horizon);
+        let (dv, dw) = (self.dim_v(), self.dim_w());
         let (ret, rest) = out.split_at_mut(count);
         let (gv, gw) = rest.split_at_mut(dv * count);
         if let Some((p, pol)) = self.scalar {
@@ -251,26 +274,13 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         for i in 0..count {
             acc_v.fill(0.0);
             acc_w.fill(0.0);
-            let mut rngs = rngs_from_prefix(self.prefix, first + i as u64);
             let mut sink = GpomdpTraj {
                 bv: &b.v,
                 bw: &b.w,
                 gv: &mut acc_v,
                 gw: &mut acc_w,
             };
-            let (len, g) = kernel(
-                self.env,
-                self.policy,
-                self.fused,
-                self.gamma,
-                self.limit,
-                &mut rngs,
-                &mut sink,
-                sc,
-            );
-            for t in len..h {
-                sink.record(t, 0.0, &sc.cum_v, &sc.cum_w);
-            }
+            let (len, g) = self.padded(first + i as u64, &mut sink, sc);
             ret[i] = g;
             for (k, a) in acc_v.iter().enumerate() {
                 gv[k * count + i] = *a;
@@ -343,24 +353,11 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
         }
         let mut steps = 0;
         for i in 0..count {
-            let mut rngs = rngs_from_prefix(self.prefix, first + i as u64);
             let mut sink = FitSink {
                 sums: &mut *sums,
                 last: (0.0, 0.0),
             };
-            let (len, _) = kernel(
-                self.env,
-                self.policy,
-                self.fused,
-                self.gamma,
-                self.limit,
-                &mut rngs,
-                &mut sink,
-                sc,
-            );
-            for t in len..h {
-                TrajSink::record(&mut sink, t, 0.0, &sc.cum_v, &sc.cum_w);
-            }
+            let (len, _) = self.padded(first + i as u64, &mut sink, sc);
             steps += len as u64;
         }
         steps

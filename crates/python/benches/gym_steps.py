@@ -53,9 +53,12 @@ def reinforce(env, iterations, n, horizon, seed):
 
 
 def sepg_run(env, algorithm, iterations, n, horizon, seed):
+    # No reference batch (reference_batch=0, the thesis's pseudocode): every step measured
+    # belongs to an iteration, as in the REINFORCE loop. The reference batch's trajectories
+    # need no scores and would raise the rate.
     run = sepg_gym.GymRun(
         env, features, gamma=0.99, r_max=100.0, m_phi=1.2, algorithm=algorithm,
-        n_trajectories=n, horizon=horizon, seed=seed, show_derivation=False,
+        n_trajectories=n, horizon=horizon, seed=seed, show_derivation=False, reference_batch=0,
     )
     start = time.perf_counter()
     run.run(iterations)

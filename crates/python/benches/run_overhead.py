@@ -1,11 +1,17 @@
-"""Wall time of the same run through the command line and through the Python API, each as a
-whole process (interpreter start-up and imports included), alternated and repeated; prints
-the median of each and their ratio.
+"""Time of the same run through the command line and through the Python API, each as a whole
+process (interpreter start-up and imports included), interleaved and repeated.
+
+Prints, for wall-clock and for CPU time (user + system of the child process, less sensitive
+to the load of a shared machine), the median of each path, the median of the per-repetition
+ratios Python / command line and their range; then the fixed cost of the Python path on its
+own: an interpreter that only starts (``python -c pass``) and one that only imports
+``sepg.runs``.
 
     cargo build --release && .venv/bin/python crates/python/benches/run_overhead.py
 """
 
 import argparse
+import os
 import pathlib
 import shutil
 import statistics
@@ -18,35 +24,55 @@ ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
 def timed(cmd):
+    """(wall-clock seconds, CPU seconds) of the process `cmd`."""
+    before = os.times()
     start = time.perf_counter()
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    wall = time.perf_counter() - start
+    after = os.times()
+    cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
+    return wall, cpu
+
+
+def report(name, cli, py):
+    ratios = sorted(q / c for c, q in zip(cli, py))
+    print(
+        f"{name:>5}: command line {statistics.median(cli):.3f} s, Python API {statistics.median(py):.3f} s; "
+        f"ratio median {statistics.median(ratios):.3f}, range {ratios[0]:.3f}-{ratios[-1]:.3f}"
+    )
 
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("--repeats", type=int, default=5)
-    p.add_argument("--iterations", type=int, default=5000)
+    p.add_argument("--repeats", type=int, default=9)
+    p.add_argument("--iterations", type=int, default=10000)
     p.add_argument("--env", default="lqg1d")
     p.add_argument("--algo", default="sepg-zv")
     a = p.parse_args()
     options = dict(env=a.env, algo=a.algo, iterations=a.iterations, batch=100, seed=1)
     flags = [x for k, v in options.items() for x in (f"--{k}", str(v))]
     tmp = pathlib.Path(tempfile.mkdtemp())
-    cli, py = [], []
+    times = {"cli": [], "py": [], "start": [], "import": []}
     for i in range(a.repeats):
-        for name, out in (("cli", cli), ("py", py)):
+        for name in times:
             d = tmp / f"{name}-{i}"
             if name == "cli":
                 cmd = [str(ROOT / "target/release/sepg"), "run", "--quiet", "--out", str(d), *flags]
+            elif name == "py":
+                cmd = [sys.executable, "-c", f"import sepg.runs; sepg.runs.run({str(d)!r}, **{options!r})"]
+            elif name == "start":
+                cmd = [sys.executable, "-c", "pass"]
             else:
-                cmd = [sys.executable, "-c",
-                       f"import sepg.runs; sepg.runs.run({str(d)!r}, **{options!r})"]
-            out.append(timed(cmd))
-            shutil.rmtree(d)
-    c, q = statistics.median(cli), statistics.median(py)
-    print(f"{a.env} {a.algo}, {a.iterations} iterations of N = 100, median of {a.repeats}:")
-    print(f"command line {c:.3f} s, Python API {q:.3f} s, ratio {q / c:.3f}")
+                cmd = [sys.executable, "-c", "import sepg.runs"]
+            times[name].append(timed(cmd))
+            shutil.rmtree(d, ignore_errors=True)
+    print(f"{a.env} {a.algo}, {a.iterations} iterations of N = 100, {a.repeats} interleaved repetitions:")
+    for k, label in ((0, "wall"), (1, "CPU")):
+        report(label, [t[k] for t in times["cli"]], [t[k] for t in times["py"]])
+    for k, label in ((0, "wall"), (1, "CPU")):
+        start = statistics.median(t[k] for t in times["start"])
+        imp = statistics.median(t[k] for t in times["import"])
+        print(f"{label:>5}: python -c pass {start:.3f} s, python -c 'import sepg.runs' {imp:.3f} s")
 
 
 if __name__ == "__main__":

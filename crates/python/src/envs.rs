@@ -1,6 +1,7 @@
-//! The built-in environments from Python: exact J and derivatives of the LQG presets (the
-//! oracles of `sepg_mdp`, as `sepg exact`), Monte Carlo estimates with 95% Student-t
-//! intervals (as `sepg estimate`), and Mountain Car transitions for cross-checks against
+//! The built-in environments from Python: exact J and derivatives of the LQG presets and
+//! Monte Carlo estimates with 95% Student-t intervals, through `sepg_runs::exact` and
+//! `sepg_runs::estimate` as `sepg exact` and `sepg estimate` (the same checks of the
+//! arguments, the same numbers), and Mountain Car transitions for cross-checks against
 //! gymnasium.
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -10,27 +11,19 @@ use sepg_mdp::MountainCar;
 use sepg_mdp::features::FeatureMap;
 use sepg_mdp::rng::rng_from_seed;
 
-use nalgebra::DVector;
-use numpy::PyArray1 as Arr;
 use pyo3::types::PyDict;
-use sepg_estimators::{Estimate, Estimator, GradientSpec, Param, Width};
-use sepg_mdp::env::Preset;
-use sepg_mdp::oracle::{
-    ClippedDpOracle, ClosedFormOracle, ExactOracle, Exploration, Horizon, OracleError,
-};
-use sepg_mdp::rng::SeedKey;
-use sepg_mdp::rollout::rollout;
-use sepg_mdp::{GaussianPolicy, LqgModel};
+use sepg_mdp::oracle::Horizon;
+use sepg_runs::estimate::{EstimateSpec, Interval};
+use sepg_runs::exact::ExactSpec;
 
 use crate::{failed, floats, invalid, vector};
 
-/// Input problems are [`invalid`]; numerical failures of the oracle are [`failed`].
-fn oracle_error(e: OracleError) -> PyErr {
-    match e {
-        OracleError::NotConverged { .. }
-        | OracleError::Overflow
-        | OracleError::ResolutionExceeded { .. } => failed(e),
-        _ => invalid(e),
+/// [`invalid`] for an error of bad input, [`failed`] otherwise.
+fn run_error(e: sepg_runs::Error) -> PyErr {
+    if e.is_invalid_input() {
+        invalid(e)
+    } else {
+        failed(e)
     }
 }
 
@@ -38,8 +31,9 @@ fn oracle_error(e: OracleError) -> PyErr {
 /// `"lqg1d"`) with the policy a ~ N(v s, σ²) (σ = 0: deterministic): the closed form of the
 /// unclipped model (any horizon; `horizon=None` is the infinite discounted sum), or dynamic
 /// programming on the clipped model (`clipped=True`, finite horizon, default 20), with
-/// transition noise η. Returns a dict with `j`, `grad_v`, and for σ > 0 `grad_w`,
-/// `grad_sigma`, `mixed_wv` (∂²J/∂w∂v), plus `hessian` when the oracle computes it.
+/// transition noise η; `sepg_runs::exact`, as `sepg exact`. Returns a dict with `j`,
+/// `grad_v`, and for σ > 0 `grad_w`, `grad_sigma`, `mixed_wv` (∂²J/∂w∂v), plus `hessian`
+/// when the oracle computes it.
 #[pyfunction]
 #[pyo3(signature = (env, v, sigma, horizon = None, eta = 0.0, clipped = false))]
 fn exact<'py>(
@@ -51,49 +45,17 @@ fn exact<'py>(
     eta: f64,
     clipped: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let model = match env {
-        "lqg" => LqgModel::thesis(),
-        "lqg1d" => LqgModel::lqg1d(),
-        other => {
-            return Err(invalid(format!(
-                "exact values exist for the presets lqg and lqg1d, not {other:?}"
-            )));
-        }
+    let spec = ExactSpec {
+        env: env.to_string(),
+        v,
+        sigma,
+        horizon: horizon.map(Horizon::Finite),
+        eta,
+        clipped,
     };
-    for (name, x) in [("sigma", sigma), ("eta", eta)] {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(invalid(format!("{name} must be finite and >= 0, got {x}")));
-        }
-    }
-    if !v.is_finite() {
-        return Err(invalid(format!("v must be finite, got {v}")));
-    }
-    let model = model
-        .with_noise(DVector::from_element(1, eta))
-        .map_err(invalid)?;
-    let exploration = if sigma == 0.0 {
-        Exploration::Deterministic
-    } else {
-        Exploration::Gaussian {
-            w: vec![sigma.ln()],
-        }
-    };
-    let horizon = match (horizon, clipped) {
-        (Some(0), _) => return Err(invalid("horizon must be at least 1")),
-        (Some(h), _) => Horizon::Finite(h),
-        (None, true) => Horizon::Finite(20),
-        (None, false) => Horizon::Infinite,
-    };
-    let eval = if clipped {
-        ClippedDpOracle::new(&model)
-            .map_err(oracle_error)?
-            .evaluate(&[v], &exploration, horizon)
-    } else {
-        ClosedFormOracle::new(&model)
-            .map_err(oracle_error)?
-            .evaluate(&[v], &exploration, horizon)
-    }
-    .map_err(oracle_error)?;
+    let (eval, _) = py
+        .detach(|| sepg_runs::exact::exact(&spec))
+        .map_err(run_error)?;
     let out = PyDict::new(py);
     out.set_item("j", eval.j)?;
     out.set_item("grad_v", eval.grad_v[0])?;
@@ -111,25 +73,29 @@ fn exact<'py>(
     Ok(out)
 }
 
-/// The mean and the 95% Student-t interval `[lo, hi]` of each component of an estimate.
-fn interval(e: &Estimate) -> PyResult<(Vec<f64>, Vec<Vec<f64>>)> {
-    let mut half = vec![0.0; e.dim()];
-    e.widths_into(Width::StudentT, 0.05, &mut half)
-        .map_err(failed)?;
-    let ci = e
-        .mean()
-        .iter()
-        .zip(&half)
-        .map(|(m, h)| vec![m - h, m + h])
-        .collect();
-    Ok((e.mean().to_vec(), ci))
+/// Means `(k,)` and 95% intervals `(k, 2)` of an estimate.
+type Means<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// The means and 95% intervals of an estimate, as `(means (k,), intervals (k, 2))`.
+fn arrays<'py>(py: Python<'py>, i: &Interval) -> PyResult<Means<'py>> {
+    let (mean, ci): (Vec<f64>, Vec<Vec<f64>>) = match i {
+        Interval::Scalar { mean, ci95 } => (vec![*mean], vec![ci95.to_vec()]),
+        Interval::Vector { mean, ci95 } => {
+            (mean.clone(), ci95.iter().map(|c| c.to_vec()).collect())
+        }
+    };
+    Ok((
+        PyArray1::from_vec(py, mean),
+        PyArray2::from_vec2(py, &ci).map_err(failed)?,
+    ))
 }
 
-/// Monte Carlo estimates of J, ∇_v J and ∇_w J (G(PO)MDP with the leave-one-out optimal
-/// baseline) from `n` ≥ 2 trajectories of `horizon` steps of the built-in environment `env`
-/// (`lqg`, `lqg1d`, `lqg-nd`, `mountain-car`) under N(v φ(s), σ²), with 95% Student-t
-/// intervals (Sec 4.5), as `sepg estimate`: a dict with `j`, `grad_v`, `grad_w` (each a pair
-/// `(mean, ci95)`), `steps`.
+/// Monte Carlo estimates of J, ∇_v J and ∇_w J from `n` ≥ 2 trajectories of `horizon` steps
+/// of the built-in environment `env` (`lqg`, `lqg1d`, `lqg-nd`, `mountain-car`) under
+/// N(v φ(s), σ²) (σ = 0: deterministic, J only), with 95% Student-t intervals (Sec 4.5):
+/// `sepg_runs::estimate`, as `sepg estimate`, the same numbers. A dict with `j` (a pair
+/// `(mean, [lo, hi])`), `grad_v`, `grad_w` (pairs `(means, intervals (k, 2))`, `None` for
+/// σ = 0), `steps` and `steps_per_sec`.
 #[pyfunction]
 #[pyo3(signature = (env, v, sigma, horizon, n, seed = 0))]
 fn estimate<'py>(
@@ -141,38 +107,30 @@ fn estimate<'py>(
     n: usize,
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let env = Preset::from_name(env).map_err(invalid)?.build();
-    let v = vector(v, "v")?;
-    if n < 2 || horizon == 0 {
-        return Err(invalid(format!(
-            "n must be at least 2 and horizon at least 1, got n = {n}, horizon = {horizon}"
-        )));
-    }
-    if !(sigma.is_finite() && sigma > 0.0) {
-        return Err(invalid(format!(
-            "sigma must be finite and > 0, got {sigma}"
-        )));
-    }
-    let policy = GaussianPolicy::new(v, vec![sigma.ln(); env.action_dim()], env.feature_dim())
-        .map_err(invalid)?;
-    let batch = py
-        .detach(|| rollout(&env, &policy, n, horizon, SeedKey::new(seed, 0, 0)))
-        .map_err(invalid)?;
-    let mut estimator = Estimator::new();
-    let mut est = Estimate::new();
+    let spec = EstimateSpec {
+        env: env.to_string(),
+        v: vector(v, "v")?,
+        sigma,
+        horizon,
+        n,
+        seed,
+    };
+    let r = py
+        .detach(|| sepg_runs::estimate::estimate(&spec))
+        .map_err(run_error)?;
     let out = PyDict::new(py);
-    estimator.value(&batch, &mut est).map_err(failed)?;
-    let (m, ci) = interval(&est)?;
-    out.set_item("j", (m[0], ci[0].clone()))?;
-    for (name, param) in [("grad_v", Param::V), ("grad_w", Param::W)] {
-        estimator
-            .gradient(&batch, param, GradientSpec::default(), &mut est)
-            .map_err(failed)?;
-        let (m, ci) = interval(&est)?;
-        let ci = PyArray2::from_vec2(py, &ci).map_err(failed)?;
-        out.set_item(name, (Arr::from_vec(py, m), ci))?;
+    let Interval::Scalar { mean, ci95 } = r.j else {
+        return Err(failed("the estimate of J is not a scalar"));
+    };
+    out.set_item("j", (mean, ci95.to_vec()))?;
+    for (name, i) in [("grad_v", &r.grad_v), ("grad_w", &r.grad_w)] {
+        match i {
+            Some(i) => out.set_item(name, arrays(py, i)?)?,
+            None => out.set_item(name, py.None())?,
+        }
     }
-    out.set_item("steps", batch.steps())?;
+    out.set_item("steps", r.steps)?;
+    out.set_item("steps_per_sec", r.steps_per_sec)?;
     Ok(out)
 }
 

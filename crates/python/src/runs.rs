@@ -14,7 +14,7 @@ use sepg_runs::Error;
 use sepg_runs::folder::{self, Log, RUN_FILES};
 use sepg_runs::run::{self, Observer, RunOptions};
 use sepg_runs::spec::RunSpec;
-use sepg_runs::sweep::{self, Shard, SweepFile, SweepOptions, SweepSpec};
+use sepg_runs::sweep::{self, Shard, SweepOptions, SweepSpec};
 
 use crate::{failed, invalid};
 
@@ -45,11 +45,16 @@ impl SignalWatch {
         if let Some(err) = self.error.lock().ok().and_then(|mut s| s.take()) {
             return err;
         }
-        if e.is_invalid_input() {
-            invalid(e)
-        } else {
-            failed(e)
-        }
+        run_error(e)
+    }
+}
+
+/// [`invalid`] for an error of bad input, [`failed`] otherwise.
+fn run_error(e: Error) -> PyErr {
+    if e.is_invalid_input() {
+        invalid(e)
+    } else {
+        failed(e)
     }
 }
 
@@ -213,8 +218,8 @@ fn sweep_folder(
 }
 
 /// Creates the sweep folder `out` with its `sweep.json` without running anything, so that
-/// the runs can be mapped over a cluster engine with [`sweep_run`]; returns the indices of
-/// the shard's runs.
+/// the runs can be mapped over a cluster engine with [`sweep_run`] and closed with
+/// [`sweep_finish`]; returns the indices of the shard's runs.
 #[pyfunction]
 #[pyo3(signature = (out, spec, shard = None, force = false))]
 fn sweep_prepare(
@@ -224,14 +229,7 @@ fn sweep_prepare(
     force: bool,
 ) -> PyResult<Vec<usize>> {
     let (file, _) = sweep::expand(&parse_sweep(spec)?, parse_shard(shard)?).map_err(invalid)?;
-    folder::check_out_dir(&out, force, &[sweep::SWEEP_FILE, sweep::RUNS_DIR]).map_err(invalid)?;
-    std::fs::create_dir_all(&out)
-        .map_err(|e| failed(format!("cannot create {}: {e}", out.display())))?;
-    folder::write_atomic(
-        &out.join(sweep::SWEEP_FILE),
-        folder::to_json_line(&file).map_err(failed)?.as_bytes(),
-    )
-    .map_err(failed)?;
+    sweep::prepare(&out, &file, force).map_err(run_error)?;
     Ok(file.shard_runs().map(|r| r.index).collect())
 }
 
@@ -246,42 +244,22 @@ fn sweep_run(
     index: usize,
     checkpoint_every: u64,
 ) -> PyResult<PathBuf> {
-    let file = SweepFile::read(&out).map_err(invalid)?;
-    let (expected, resolved) = sweep::expand(&file.spec, file.shard).map_err(invalid)?;
-    if expected.sweep_id != file.sweep_id {
-        return Err(invalid(format!(
-            "{} was written by another sepg version (sweep id differs)",
-            out.display()
-        )));
-    }
-    let entry = file
-        .shard_runs()
-        .find(|r| r.index == index)
-        .ok_or_else(|| {
-            invalid(format!(
-                "run {index} is not in the shard of {}",
-                out.display()
-            ))
-        })?;
-    let dir = out.join(&entry.dir);
-    if folder::is_complete(&dir) {
-        return Ok(dir);
-    }
     let watch = SignalWatch::new();
     let opts = RunOptions {
         checkpoint_every: checkpoint_period(checkpoint_every)?,
         stop: &watch.stop,
         observer: &watch,
     };
-    let done = py.detach(|| {
-        if dir.join(folder::CONFIG_FILE).is_file() {
-            run::resume(&dir, opts)
-        } else {
-            run::start(&dir, &resolved[index], opts)
-        }
-    });
-    done.map_err(|e| watch.error(e))?;
-    Ok(dir)
+    py.detach(|| sweep::run_one(&out, index, opts))
+        .map_err(|e| watch.error(e))
+}
+
+/// Closes the sweep folder `out` once every run of its shard is complete: writes
+/// `summary.csv` as `sepg sweep` does at its end; returns `sweep.json` as text.
+#[pyfunction]
+fn sweep_finish(out: PathBuf) -> PyResult<String> {
+    let file = sweep::finish(&out).map_err(run_error)?;
+    json(&file)
 }
 
 /// Merges the complete shard folders `shards` of one sweep into `out`; returns the merged
@@ -289,13 +267,7 @@ fn sweep_run(
 #[pyfunction]
 #[pyo3(signature = (shards, out, force = false))]
 fn merge_folders(shards: Vec<PathBuf>, out: PathBuf, force: bool) -> PyResult<String> {
-    let file = sepg_runs::merge::merge(&shards, &out, force).map_err(|e| {
-        if e.is_invalid_input() {
-            invalid(e)
-        } else {
-            failed(e)
-        }
-    })?;
+    let file = sepg_runs::merge::merge(&shards, &out, force).map_err(run_error)?;
     json(&file)
 }
 
@@ -310,13 +282,7 @@ fn audit_folder(dir: PathBuf, tolerance: f64, alpha: f64) -> PyResult<String> {
             "tolerance = {tolerance} must be finite and non-negative"
         )));
     }
-    let report = sepg_runs::audit::audit(&dir, tolerance, alpha).map_err(|e| {
-        if e.is_invalid_input() {
-            invalid(e)
-        } else {
-            failed(e)
-        }
-    })?;
+    let report = sepg_runs::audit::audit(&dir, tolerance, alpha).map_err(run_error)?;
     json(&report)
 }
 
@@ -352,6 +318,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_folder, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_prepare, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_finish, m)?)?;
     m.add_function(wrap_pyfunction!(merge_folders, m)?)?;
     m.add_function(wrap_pyfunction!(audit_folder, m)?)?;
     m.add_function(wrap_pyfunction!(read_sweep_file, m)?)?;

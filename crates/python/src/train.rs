@@ -10,6 +10,7 @@ use pyo3::types::PyModule;
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::seed::Block;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
@@ -245,9 +246,11 @@ impl Trainer {
     /// A trainer for `algorithm` (named as on the command line) with validated `constants`,
     /// `actions` action dimensions and `features` features; v⁰ (default −0.1 everywhere,
     /// action-major `v[j·p + i]`), σ⁰ (default 1), N trajectories per iteration, seed, δ,
-    /// initial budget B⁰ ≥ 0.
+    /// initial budget B⁰ ≥ 0, and N₀, the trajectories of the reference batch that estimates
+    /// J(θ⁰) before the first iteration of SEPG (default 1000; 0 takes J(θ⁰) from the first
+    /// v-block as the thesis's pseudocode does; 1 is an error).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -267,6 +270,7 @@ impl Trainer {
         beta: Option<f64>,
         lr: Option<f64>,
         lr_w: Option<f64>,
+        reference_batch: Option<usize>,
     ) -> PyResult<Self> {
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
@@ -314,7 +318,13 @@ impl Trainer {
             features,
             error: Arc::clone(&error),
         };
-        let solver = PolicySolver::with_collector(&config, Box::new(collector)).map_err(invalid)?;
+        let mut options = SepgOptions::default();
+        if let Some(n0) = reference_batch {
+            options.reference_batch = n0;
+        }
+        let solver = PolicySolver::with_collector(&config, Box::new(collector))
+            .and_then(|s| s.with_options(options))
+            .map_err(invalid)?;
         let state = State::new(v0, sigma0.iter().map(|s| s.ln()).collect(), initial_budget);
         Ok(Trainer {
             parts: Some((solver, state)),

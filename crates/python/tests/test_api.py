@@ -23,9 +23,14 @@ def test_every_native_item_has_a_docstring_and_a_stub():
 
 def test_bounds_exports_every_bound_function():
     prefixes = ("constants_", "pirotta_", "papini_", "batch_size_", "v_update_", "w_update_",
-                "surrogate_", "high_probability_", "greedy_", "rigorous_", "budget_")
+                "surrogate_", "high_probability_", "greedy_", "rigorous_", "budget_", "exploring_",
+                "certified_")
     native = {n for n in dir(_native) if n.startswith(prefixes)}
     assert native <= set(bounds.__all__)
-    assert len(native) == 43
+    # 43 functions of the closed forms, 5 more of the rigorous module (K_W, K_MU, the sound
+    # c and its v-steps), the exploring w-step, and 13 of the certified module.
+    assert len(native) == 43 + 5 + 1 + 13
+    classes = {"Budget", "Certified", "Enclosure", "ExploringBound", "HighProbabilityBound", "Interval", "StepOutcome"}
+    assert classes <= set(bounds.__all__)
     for name in sepg.__all__:
         assert hasattr(sepg, name), name

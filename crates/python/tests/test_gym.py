@@ -1,6 +1,8 @@
 """SEPG on gymnasium environments: determinism, vector environments, constants, errors, and
 the cross-check of the built-in mountain-car against gymnasium's MountainCarContinuous-v0."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -18,27 +20,30 @@ def small_run(env, **kw):
     return sg.GymRun(env, **args)
 
 
-@pytest.mark.xfail(reason="reference batches of the new SEPG default (issue 11) are not yet followed by the gym collector and Dask sweep tests", strict=False)
 def test_same_seed_same_records_other_seed_other_records():
-    a = small_run(MCC)
+    # A small reference batch of J(theta^0) keeps the test short; its 20 trajectories are
+    # collected before iteration 0, once for J(theta^0) of the exploratory policy and once
+    # for the target's (type-II requirement ZV): 2 x 20 + 3 iterations x 12.
+    a = small_run(MCC, reference_batch=20)
     a.run(3)
-    b = small_run(MCC)
+    b = small_run(MCC, reference_batch=20)
     b.run(2)
     b.run(1)  # resuming between iterations changes nothing
-    c = small_run(MCC, seed=4)
+    c = small_run(MCC, seed=4, reference_batch=20)
     c.run(3)
     assert a.records == b.records
     assert a.records != c.records
     assert [r["iteration"] for r in a.records] == [0, 1, 2]
-    assert a.records[-1]["trajectories"] == 36
+    assert [r["trajectories"] for r in a.records] == [52, 64, 76]
 
 
-@pytest.mark.xfail(reason="reference batches of the new SEPG default (issue 11) are not yet followed by the gym collector and Dask sweep tests", strict=False)
 def test_a_vector_env_gives_the_records_of_a_single_env():
-    single = small_run(gymnasium.make(MCC), algorithm="sepg-lv", n_trajectories=15)
+    # Batches of 30 (the reference batch) and 5 (a third of 15) trajectories leave a partial
+    # last group of the 4 environments.
+    single = small_run(gymnasium.make(MCC), algorithm="sepg-lv", n_trajectories=15, reference_batch=30)
     single.run(2)
     vec = gymnasium.make_vec(MCC, num_envs=4, vectorization_mode="sync")
-    vector = small_run(vec, algorithm="sepg-lv", n_trajectories=15)
+    vector = small_run(vec, algorithm="sepg-lv", n_trajectories=15, reference_batch=30)
     vector.run(2)
     assert single.records == vector.records
 
@@ -110,14 +115,13 @@ class Boom(Exception):
     pass
 
 
-@pytest.mark.xfail(reason="reference batches of the new SEPG default (issue 11) are not yet followed by the gym collector and Dask sweep tests", strict=False)
 def test_a_collector_exception_is_raised_as_it_is_and_the_state_is_kept():
     k = sepg.TaskConstants(0.9, 1.0, 1.0, 2.0)
     calls = []
 
     def collector(req):
-        calls.append(req.block)
-        if len(calls) > 3:
+        calls.append((req.iteration, req.block))
+        if req.iteration >= 1:
             raise Boom("no more trajectories")
         n = req.n
         return np.ones((n, 2)), np.zeros((n, 2, 1)), np.ones((n, 2, 1)), np.full(n, 2)
@@ -126,7 +130,43 @@ def test_a_collector_exception_is_raised_as_it_is_and_the_state_is_kept():
     trainer.run(1)
     with pytest.raises(Boom, match="no more"):
         trainer.run(1)
+    assert calls[-1][0] == 1
     assert '"iteration":1' in trainer.state()
+
+
+def fake_collector(requests):
+    """A collector of constant trajectories (reward 1, two steps) that records each request
+    as (iteration, block, n)."""
+
+    def collect(req):
+        requests.append((req.iteration, req.block, req.n))
+        n = req.n
+        return np.ones((n, 2)), np.zeros((n, 2, 1)), np.ones((n, 2, 1)), np.full(n, 2)
+
+    return collect
+
+
+@pytest.mark.parametrize("reference_batch,first", [(None, 1000), (0, None), (7, 7)])
+def test_the_reference_batch_is_collected_once_before_the_first_iteration(reference_batch, first):
+    k = sepg.TaskConstants(0.9, 1.0, 1.0, 2.0)
+    requests = []
+    options = {} if reference_batch is None else {"reference_batch": reference_batch}
+    trainer = sepg.Trainer("sepg-zv", k, 1, 1, fake_collector(requests), n_trajectories=12, **options)
+    records = json.loads(trainer.run(2))
+    reference = [r for r in requests if r[1].startswith("reference")]
+    if first is None:
+        assert reference == []
+    else:
+        assert reference and all(r[0] == 0 and r[2] == first for r in reference)
+    # Every trajectory asked for is counted, the reference batch once in iteration 0.
+    assert records[-1]["trajectories"] == sum(r[2] for r in requests)
+    assert sum(r[2] for r in requests if r[1] in ("v", "target", "w")) == 2 * 12
+
+
+def test_a_reference_batch_of_one_trajectory_is_refused():
+    k = sepg.TaskConstants(0.9, 1.0, 1.0, 2.0)
+    with pytest.raises(sepg.InvalidInputError, match="reference batch"):
+        sepg.Trainer("sepg-zv", k, 1, 1, fake_collector([]), n_trajectories=12, reference_batch=1)
 
 
 @pytest.mark.parametrize(

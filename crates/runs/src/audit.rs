@@ -1037,3 +1037,152 @@ pub fn render(report: &AuditReport) -> String {
     };
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sepg_mdp::lqg_model::LqgModel;
+
+    const H: usize = 20;
+    /// w = ln 0.5 throughout.
+    fn w() -> f64 {
+        0.5f64.ln()
+    }
+
+    fn oracle() -> Box<dyn ExactOracle> {
+        Box::new(ClippedDpOracle::new(&LqgModel::thesis()).expect("the lqg preset has a DP"))
+    }
+
+    /// Exact J of N(v s, e^{2w}) on the clipped `lqg` preset, evaluated here without the
+    /// auditor's cache.
+    fn j(v: f64, w: f64) -> f64 {
+        oracle()
+            .evaluate(
+                &[v],
+                &Exploration::Gaussian { w: vec![w] },
+                Horizon::Finite(H),
+            )
+            .expect("exact J")
+            .j
+    }
+
+    fn auditor(requirement: Requirement, budget0: f64) -> Auditor {
+        Auditor {
+            source: Source::Exact(ExactJ {
+                oracle: oracle(),
+                horizon: Horizon::Finite(H),
+                cache: HashMap::new(),
+            }),
+            requirement: Some(requirement),
+            sim: matches!(requirement, Requirement::Sim { .. }),
+            has_target: matches!(
+                requirement,
+                Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+            ),
+            budget0,
+            tolerance: 1e-9,
+            first: None,
+            tallies: BTreeMap::new(),
+            failures: Vec::new(),
+            skipped: 0,
+        }
+    }
+
+    /// A logged row at θ = (v, w) whose logged J's are deliberately wrong (−1e6): with an
+    /// oracle, the audit must use exact J only.
+    fn row(t: u64, v: f64, w: f64, guaranteed_w: Option<f64>) -> Row {
+        Row {
+            iteration: t,
+            v: vec![v],
+            w: vec![w],
+            j_explore: -1e6,
+            j_after_v: Some(-1e6),
+            j_target: -1e6,
+            w_target: vec![f64::NEG_INFINITY],
+            budget: 0.0,
+            alpha: 1.0,
+            beta: 1.0,
+            guaranteed_v: None,
+            guaranteed_w,
+        }
+    }
+
+    fn next(v: f64, w: f64) -> Option<Next> {
+        Some((vec![v], vec![w], Some(-1e6)))
+    }
+
+    fn tally(a: &Auditor, name: &str) -> (u64, u64, f64) {
+        let t = &a.tallies[name];
+        (t.checked, t.failed, t.worst.0)
+    }
+
+    /// Mean parameters with J(v_low) < J(v_mid) < J(v_high) at w = ln 0.5 (checked below).
+    const V_LOW: f64 = -0.05;
+    const V_MID: f64 = -0.2;
+    const V_HIGH: f64 = -0.5;
+
+    #[test]
+    fn ordering_of_the_test_parameters() {
+        let (lo, mid, hi) = (j(V_LOW, w()), j(V_MID, w()), j(V_HIGH, w()));
+        assert!(lo < mid && mid < hi, "{lo} {mid} {hi}");
+    }
+
+    #[test]
+    fn lb_i_compares_with_the_first_j_not_the_previous_one() {
+        // θ⁰ = V_LOW, θ¹ = V_HIGH, θ² = V_MID: J falls from θ¹ to θ² but stays above J(θ⁰),
+        // which LB-I allows; a θ³ = V_LOW − 0.1 below J(θ⁰) breaks it.
+        let below = V_LOW + 0.1;
+        assert!(j(below, w()) < j(V_LOW, w()));
+        let mut a = auditor(Requirement::LbI { nu: 0.5 }, 0.0);
+        let path = [V_LOW, V_HIGH, V_MID, below];
+        for (t, pair) in path.windows(2).enumerate() {
+            a.row(&row(t as u64, pair[0], w(), None), next(pair[1], w()))
+                .unwrap();
+        }
+        let (checked, failed, worst) = tally(&a, "lb-i");
+        assert_eq!((checked, failed), (3, 1));
+        assert_eq!(worst, j(V_LOW, w()) - j(below, w()));
+        assert_eq!(
+            a.failures.iter().map(|f| f.iteration).collect::<Vec<_>>(),
+            [2]
+        );
+    }
+
+    #[test]
+    fn budget_exact_telescopes_from_the_first_j() {
+        // LB-II, B⁰ = 0: the exploratory policy after the v-step of row t is (vᵗ⁺¹, wᵗ), so the
+        // recomputed budget of row t is J(vᵗ⁺¹, w) − J(θ⁰) (Definition 4.3 telescoped). With
+        // θ⁰ = V_LOW, θ¹ = V_HIGH, θ² = V_MID it stays positive although J falls at row 1.
+        let mut a = auditor(Requirement::LbII, 0.0);
+        a.row(&row(0, V_LOW, w(), None), next(V_HIGH, w())).unwrap();
+        a.row(&row(1, V_HIGH, w(), None), next(V_MID, w())).unwrap();
+        let (checked, failed, worst) = tally(&a, "budget-exact");
+        assert_eq!((checked, failed), (2, 0));
+        let j0 = j(V_LOW, w());
+        let smallest = (0.0 + j(V_HIGH, w()) - j0).min(0.0 + j(V_MID, w()) - j0);
+        assert_eq!(worst, -smallest);
+        // B⁰ = 0 and a first v-step that loses: the budget is negative from row 0 on.
+        let mut a = auditor(Requirement::LbII, 0.0);
+        a.row(&row(0, V_MID, w(), None), next(V_LOW, w())).unwrap();
+        assert_eq!(tally(&a, "budget-exact").1, 1);
+    }
+
+    #[test]
+    fn guarantee_w_measures_the_w_step_from_after_the_v_step() {
+        // Row 0 goes from (V_LOW, w) to (V_HIGH, w + 0.1): the w-step's own gain is
+        // J(V_HIGH, w + 0.1) − J(V_HIGH, w), much smaller than the gain from J(θ⁰).
+        let w1 = w() + 0.1;
+        let gain_w = j(V_HIGH, w1) - j(V_HIGH, w());
+        let gain_total = j(V_HIGH, w1) - j(V_LOW, w());
+        assert!(gain_total > gain_w + 1e-3, "{gain_total} {gain_w}");
+        // A guarantee just above the w-step's gain fails; one just below holds.
+        for (g, failed) in [(gain_w + 1e-4, 1), (gain_w - 1e-4, 0)] {
+            let mut a = auditor(Requirement::LbI { nu: 0.5 }, 0.0);
+            a.row(&row(0, V_LOW, w(), Some(g)), next(V_HIGH, w1))
+                .unwrap();
+            let (checked, f, worst) = tally(&a, "guarantee-w");
+            assert_eq!((checked, f), (1, failed), "guarantee {g}");
+            assert_eq!(worst, g - (j(V_HIGH, w1) - j(V_HIGH, w())));
+        }
+    }
+}

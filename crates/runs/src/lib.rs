@@ -14,7 +14,8 @@
 //! spec, folder          options and their resolution; the files of a run folder
 //! ```
 //!
-//! [`estimate`] (streamed Monte Carlo estimates of one policy) stands alone.
+//! [`estimate`] (streamed Monte Carlo estimates of one policy) and [`exact`] (exact values of
+//! an LQG preset) stand alone.
 //!
 //! [`audit`] sits beside them: it reads a run folder ([`folder`], [`spec`]) and re-checks its
 //! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
@@ -23,6 +24,7 @@
 pub mod audit;
 pub mod error;
 pub mod estimate;
+pub mod exact;
 pub mod figure;
 pub mod folder;
 pub mod merge;

@@ -21,7 +21,7 @@
 //! `runs/<preset>/<variant>/sigma-<σ⁰>/seed-<seed>`. `sweep.json` records the sweep, its
 //! identifier (a hash of every resolved run configuration), the run list and the shard.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -381,15 +381,10 @@ pub fn execute(
     let results: Vec<Result<()>> = todo
         .par_iter()
         .map(|(entry, res)| {
-            let run_dir = dir.join(&entry.dir);
-            let out = if run_dir.join(CONFIG_FILE).is_file() {
-                run::resume(&run_dir, run_opts)
-            } else {
-                run::start(&run_dir, res, run_opts)
-            };
+            let out = run_entry(dir, entry, res, run_opts);
             opts.observer
                 .advance(finished.fetch_add(1, Ordering::SeqCst) + 1);
-            out.map(|_| ())
+            out
         })
         .collect();
     opts.observer.end();
@@ -433,11 +428,95 @@ pub fn start(
     force: bool,
     opts: SweepOptions<'_>,
 ) -> Result<SweepStats> {
+    prepare(dir, file, force)?;
+    execute(dir, file, resolved, opts)
+}
+
+/// Creates the sweep folder `dir` with `file` as its `sweep.json` and runs nothing: the
+/// first step of [`start`], and of a sweep whose runs are mapped over a cluster engine one
+/// by one with [`run_one`] and closed by [`finish`].
+///
+/// # Errors
+/// [`Error::Invalid`] for a non-empty folder without `force`; [`Error::Failed`] when the
+/// folder or file cannot be written.
+pub fn prepare(dir: &Path, file: &SweepFile, force: bool) -> Result<()> {
     check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR, SUMMARY_CSV])?;
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::failed(format!("cannot create {}: {e}", dir.display())))?;
-    write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())?;
-    execute(dir, file, resolved, opts)
+    write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())
+}
+
+/// Runs, resumes, or leaves as it is when complete, the run of `entry` in the sweep folder
+/// `dir`: the unit of work of [`execute`] and [`run_one`].
+fn run_entry(
+    dir: &Path,
+    entry: &RunEntry,
+    resolved: &Resolved,
+    opts: RunOptions<'_>,
+) -> Result<()> {
+    let run_dir = dir.join(&entry.dir);
+    if is_complete(&run_dir) {
+        Ok(())
+    } else if run_dir.join(CONFIG_FILE).is_file() {
+        run::resume(&run_dir, opts).map(|_| ())
+    } else {
+        run::start(&run_dir, resolved, opts).map(|_| ())
+    }
+}
+
+/// Runs run `index` of the shard in the sweep folder `dir` (written by [`prepare`]), or
+/// resumes it, or leaves it as it is when complete: one deterministic unit of a sweep, the
+/// same bytes wherever it runs. Returns the run folder.
+///
+/// # Errors
+/// [`Error::Invalid`] when `dir` is not a sweep folder of this version of sepg or `index` is
+/// not a run of its shard; otherwise the run's error.
+pub fn run_one(dir: &Path, index: usize, opts: RunOptions<'_>) -> Result<PathBuf> {
+    let (file, resolved) = reopen(dir)?;
+    let entry = file
+        .shard_runs()
+        .find(|r| r.index == index)
+        .ok_or_else(|| {
+            Error::invalid(format!(
+                "run {index} is not in the shard of {}",
+                dir.display()
+            ))
+        })?;
+    run_entry(dir, entry, &resolved[index], opts)?;
+    Ok(dir.join(&entry.dir))
+}
+
+/// Closes a sweep whose runs were run one by one with [`run_one`]: once every run of the
+/// shard is complete, writes [`SUMMARY_CSV`] as [`execute`] does. Returns the sweep file.
+///
+/// # Errors
+/// [`Error::Invalid`] when `dir` is not a sweep folder or a run of its shard is incomplete;
+/// [`Error::Failed`] as [`write_summary_csv`].
+pub fn finish(dir: &Path) -> Result<SweepFile> {
+    let file = SweepFile::read(dir)?;
+    if let Some(r) = file.shard_runs().find(|r| !is_complete(&dir.join(&r.dir))) {
+        return Err(Error::invalid(format!(
+            "run {} of {} is not complete",
+            r.index,
+            dir.display()
+        )));
+    }
+    write_summary_csv(dir, &file, false)?;
+    Ok(file)
+}
+
+/// `sweep.json` of `dir` re-expanded by this version of sepg, checked to describe the same
+/// runs.
+fn reopen(dir: &Path) -> Result<(SweepFile, Vec<Resolved>)> {
+    let file = SweepFile::read(dir)?;
+    let (expected, resolved) = expand(&file.spec, file.shard)?;
+    if expected.sweep_id != file.sweep_id {
+        return Err(Error::invalid(format!(
+            "{} was written by another sepg version (sweep id differs)",
+            dir.join(SWEEP_FILE).display()
+        )));
+    }
+    Ok((file, resolved))
 }
 
 /// Resumes the sweep in `dir`: re-expands its `sweep.json` with this version of sepg, checks
@@ -447,14 +526,7 @@ pub fn start(
 /// [`Error::Invalid`] when `dir` is not a sweep folder or was written by a version of sepg
 /// that resolves it differently; otherwise as [`execute`].
 pub fn resume(dir: &Path, opts: SweepOptions<'_>) -> Result<(SweepFile, SweepStats)> {
-    let file = SweepFile::read(dir)?;
-    let (expected, resolved) = expand(&file.spec, file.shard)?;
-    if expected.sweep_id != file.sweep_id {
-        return Err(Error::invalid(format!(
-            "{} was written by another sepg version (sweep id differs)",
-            dir.join(SWEEP_FILE).display()
-        )));
-    }
+    let (file, resolved) = reopen(dir)?;
     let stats = execute(dir, &file, &resolved, opts)?;
     Ok((file, stats))
 }

@@ -1,13 +1,19 @@
 //! The exact-arithmetic campaign for certified safe steps (`sepg_bounds::certified`).
 //!
-//! For every input configuration and every bound form, the largest safe step computed in
+//! For every input configuration and every bound form (Theorems 4.2, 4.3, 4.5, 4.7–4.9 in
+//! both high-probability forms, the rigorous w-bound along ∇_wJ and ∇_wL with the real-line
+//! curvature K_W, the exploring w-update, and the guarantee of Pirotta et al.'s adaptive step,
+//! Corollary 3.11), the largest safe step computed in
 //! `f64` (uncertified) and the certified step are evaluated in multiple-precision interval
 //! arithmetic (module `mp`), with the `f64` inputs and the step taken as exact dyadic rationals and
 //! every irrational constant (π, √7, e^x, hence √(2π) and ψ) enclosed by series with rigorous
 //! remainders. The bound formulas here are written from the thesis, independently of
 //! `sepg-bounds`. A step *violates* its requirement C when the enclosure of B(step) lies
 //! entirely below C; it is *proven* when the enclosure lies entirely at or above C; anything
-//! else is *undecided* (reported, and counted as a failure of the campaign).
+//! else is *undecided* (reported, and counted as a failure of the campaign). Certified steps
+//! are tallied by the path that certified them (the a-priori rounding-error bound or interval
+//! arithmetic), so that both are shown to be sound. The adaptive step has no requirement: its
+//! certified guarantee is the lower end of its enclosure, its uncertified one the `f64` value.
 //!
 //! Configurations are random (log-uniform constants, σ, gradients with both signs, subnormal
 //! and huge gradients, requirements C = C_max·(1 − k·2⁻⁵²), C_max/2, 0, −C_max, −10·C_max)
@@ -26,7 +32,7 @@ use sepg_bounds::certified::{self, Certified};
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
-use sepg_bounds::{rigorous, v_update, w_update};
+use sepg_bounds::{exploring, pirotta, rigorous, v_update, w_update};
 
 use crate::check::splitmix64;
 use mp::{Dyadic, Mp};
@@ -60,6 +66,10 @@ pub struct FormTally {
     pub certified_steps: u64,
     /// Certified steps whose bound is below C in exact arithmetic (must be 0).
     pub certified_violations: u64,
+    /// Certified steps certified by the a-priori rounding-error bound (the fast path).
+    pub by_error_bound: u64,
+    /// Certified steps certified in interval arithmetic (the fallback, or the only path).
+    pub by_interval: u64,
     /// Certified steps whose comparison with C the 256-bit enclosure could not decide.
     pub undecided: u64,
     /// Returned enclosures that do not contain the exact bound (must be 0).
@@ -83,6 +93,8 @@ impl FormTally {
         self.uncertified_violations += o.uncertified_violations;
         self.certified_steps += o.certified_steps;
         self.certified_violations += o.certified_violations;
+        self.by_error_bound += o.by_error_bound;
+        self.by_interval += o.by_interval;
         self.undecided += o.undecided;
         self.enclosure_failures += o.enclosure_failures;
         self.uncertifiable += o.uncertifiable;
@@ -103,7 +115,7 @@ impl FormTally {
 }
 
 /// The names of the forms, in report order.
-pub const FORMS: [&str; 11] = [
+pub const FORMS: [&str; 13] = [
     "Thm 4.2 v-step",
     "Thm 4.3 w along J",
     "Thm 4.5 w along L",
@@ -115,7 +127,12 @@ pub const FORMS: [&str; 11] = [
     "rigorous w along J",
     "rigorous w along L",
     "Thm 4.8 w along J (thesis form)",
+    "exploring w along L^ (Theorem E)",
+    "Cor 3.11 adaptive step (guarantee)",
 ];
+
+/// The form whose certified guarantee is the lower end of its own enclosure (no requirement).
+const ADAPTIVE: usize = 12;
 
 /// One input configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -456,6 +473,38 @@ fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
                     .ok()?,
             )
         }
+        11 => {
+            // the exploring C_max, or Theorem 4.3's when |∇̂_wJ| ≤ ε_J makes it 0, so that
+            // negative requirements are drawn too
+            let own = exploring::w_exploring_step(k, s, j, c.eps_j, l, 0.0)
+                .ok()?
+                .c_max()?;
+            let c_max = if own > 0.0 {
+                own
+            } else {
+                w_update::c_max(k, s, j).ok()?
+            };
+            let req = c.requirement.of(c_max);
+            (
+                req,
+                exploring::w_exploring_step(k, s, j, c.eps_j, l, req).ok()?,
+                certified::exploring_safe_step(k, s, j, c.eps_j, l, req).ok()?,
+            )
+        }
+        ADAPTIVE => {
+            let (alpha, guarantee) = match pirotta::optimal_step(k, s, g).ok()? {
+                pirotta::AdaptiveStep::Step { alpha, guarantee } => (alpha, guarantee),
+                _ => return None,
+            };
+            let step = StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
+                c_max: guarantee,
+                vertex: alpha,
+                lambda: Some(0.0),
+                lo: alpha,
+                hi: alpha,
+            });
+            (guarantee, step, certified::adaptive_step(k, s, g).ok()?)
+        }
         8 => {
             let c_max = rigorous::safe_step_along_j(k, s, j, 0.0).ok()?.c_max()?;
             let req = c.requirement.of(c_max);
@@ -515,7 +564,28 @@ fn exact_bound(form: usize, c: &Case, ex: &Exact, x: f64) -> Option<Mp> {
             high_probability(x, s, &l_lo.mul(&j_lo), &l_hi.mul(&j_hi), &b, form == 6)
         }
         8 => ex.rigorous(j, x, j)?,
-        _ => ex.rigorous(j, x, l)?,
+        9 => ex.rigorous(j, x, l)?,
+        11 => {
+            // B = Δw·∇̂_wJ − |Δw|·ε_J − d·Δw² at the exact Δw = β·∇̂_wL
+            let dw = Dyadic::product(x, l);
+            let abs = Mp::point(dw.abs());
+            let dw = Mp::point(dw);
+            dw.mul(&Mp::f(j))
+                .sub(&abs.mul(&Mp::f(c.eps_j)))
+                .sub(&ex.d()?.mul(&dw.sqr()))
+        }
+        _ => {
+            // Theorem 3.10: α‖∇‖₂² − α²c‖∇‖₁²
+            let l2 = c
+                .grad_v
+                .iter()
+                .fold(Mp::int(0), |acc, &g| acc.add(&Mp::f(g).sqr()));
+            let l1 = c
+                .grad_v
+                .iter()
+                .fold(Mp::int(0), |acc, &g| acc.add(&Mp::f(g.abs())));
+            parabola(x, &l2, &ex.c()?.mul(&l1.sqr()))
+        }
     })
 }
 
@@ -543,6 +613,13 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     let Some(b) = exact_bound(form, c, ex, step) else {
         return;
     };
+    // the adaptive step certifies the lower end of its own enclosure (a vacuous −∞ when its
+    // interval evaluation overflows: nothing to check)
+    let cc = match (form == ADAPTIVE, enclosure.lo()) {
+        (false, _) => cc,
+        (true, lo) if lo.is_finite() => Mp::f(lo),
+        (true, _) => return,
+    };
     let mut failure = None;
     if !b.inside(enclosure.lo(), enclosure.hi()) {
         t.enclosure_failures += 1;
@@ -551,6 +628,11 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     match certified {
         Certified::Step(st) => {
             t.certified_steps += 1;
+            if st.by_error_bound {
+                t.by_error_bound += 1;
+            } else {
+                t.by_interval += 1;
+            }
             if st.ulps_moved > 0 {
                 t.moved += 1;
                 if st.ulps_moved > t.max_ulps {

@@ -612,6 +612,11 @@ pub(crate) fn checks() -> Vec<Check> {
         number of iterations"
         .into();
     sv.cases_quick = 100;
+    sv.basis = "theory, conditional on Assumption 4.6, as for the high-probability checks \
+        (see thm-4.7-hp-v-update): an iteration can fail only when one of its three confidence \
+        intervals misses the true gradient or a bound over-promises beyond docs/ERRATA.md §27's \
+        thresholds; the J's judged are exact (DP oracle), an independent computation"
+        .into();
     sv.cases_full = 500;
     sv.false_alarm_rate = "1e-3 family-wise: one-sided Clopper–Pearson test, Bonferroni across \
         the four runs (iterations of one run are treated as independent trials)"

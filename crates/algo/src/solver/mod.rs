@@ -76,15 +76,18 @@ impl PolicySolver {
         let cfg = config.config();
         let constants = *config.constants();
         let source: Box<dyn GradientSource> = match cfg.gradient {
-            GradientMode::Sampled { delta } => Box::new(SampledSource::new(
-                cfg.env.clone(),
-                cfg.horizon,
-                cfg.seed,
-                delta,
-                cfg.options.confidence.factor(),
-                cfg.estimator,
-                constants,
-            )),
+            GradientMode::Sampled { delta } => Box::new(
+                SampledSource::new(
+                    cfg.env.clone(),
+                    cfg.horizon,
+                    cfg.seed,
+                    delta,
+                    cfg.options.confidence.factor(),
+                    cfg.estimator,
+                    constants,
+                )
+                .with_score_action(cfg.score_action),
+            ),
             GradientMode::Exact => {
                 let unsupported = |e: sepg_mdp::oracle::OracleError| {
                     ConfigError::ExactUnsupported { env: e.to_string() }
@@ -154,6 +157,18 @@ impl PolicySolver {
     pub fn with_certified_steps(mut self, on: bool) -> Self {
         self.certified = on;
         self
+    }
+
+    /// Replaces the SEPG options of this solver, e.g. one built by
+    /// [`PolicySolver::with_collector`], which starts from [`SepgOptions::default`] (a
+    /// collector that reproduces the thesis's pseudocode sets `reference_batch` to 0).
+    ///
+    /// # Errors
+    /// As [`SepgOptions::validate`].
+    pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
+        options.validate()?;
+        self.options = options;
+        Ok(self)
     }
 
     /// The solver of `config` with every batch collected by `collector` and estimated by

@@ -6,6 +6,7 @@
 //! they are compared with is the maximiser v*_H of the exact finite-horizon J(·, σ) (H = 20),
 //! found here by golden-section search on the oracle; it differs from the infinite-horizon
 //! v* of docs/CONVENTIONS.md §1 because of the horizon. Sampled checks use fixed seeds.
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
@@ -55,7 +56,7 @@ fn finite_horizon_optimum_is_near_v_star() {
     for env in [lqg(false), lqg1d(false)] {
         let vh = v_star_h(&env, 0.5);
         assert!(
-            (vh - v_star()).abs() < 0.05,
+            abs_diff_eq!(vh, v_star(), epsilon = 0.05),
             "v*_H = {vh}, v* = {}",
             v_star()
         );
@@ -116,7 +117,7 @@ fn constant_step_exact_converges_to_the_optimum() {
         let alg = Algorithm::GpomdpConst { alpha, beta: 0.0 };
         let (records, state) = run(exact(env.clone(), alg, sigma), 3000);
         assert!(
-            (state.v[0] - vh).abs() < 1e-6,
+            abs_diff_eq!(state.v[0], vh, epsilon = 1e-6),
             "{name}: v = {}, v*_H = {vh} (α = {alpha})",
             state.v[0]
         );
@@ -154,7 +155,7 @@ fn sampled_baselines_approach_the_optimum() {
             };
             let (_, state) = run(cfg, 1000);
             assert!(
-                (state.v[0] - vh).abs() < 0.1,
+                abs_diff_eq!(state.v[0], vh, epsilon = 0.1),
                 "{alg:?} seed {seed}: v = {}, v*_H = {vh}",
                 state.v[0]
             );
@@ -173,7 +174,7 @@ fn adam_reduces_sigma_on_lqg() {
         ..SepgConfig::new(lqg(true), Algorithm::adam(0.01, 0.01))
     };
     let (records, state) = run(cfg, 200);
-    assert!((records[1].w[0] - (-0.01)).abs() < 1e-9);
+    assert_abs_diff_eq!(records[1].w[0], -0.01, epsilon = 1e-9);
     assert!(state.w[0] < -1.0, "w = {}", state.w[0]);
     assert!(records.iter().all(|r| r.alpha == 0.01 && r.beta == 0.01));
 }

@@ -1,6 +1,7 @@
 //! Chebyshev batch sizes (Corollary 3.13) and the budget of Theorem 4.1.
 
 use super::common::presets;
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use sepg_bounds::BoundsError;
 use sepg_bounds::batch_size::{gpomdp, reinforce};
 use sepg_bounds::budget::{Budget, split_requirement};
@@ -47,7 +48,7 @@ fn gpomdp_matches_printed_formula() {
             let n = gpomdp(&k, sigma, delta, eps, h).unwrap();
             // the printed bracket cancels for γ → 1: compare at 1e-9
             assert!(
-                (n as f64 - real).abs() <= 1.0 + 1e-9 * real,
+                abs_diff_eq!(n as f64, real, epsilon = 1.0 + 1e-9 * real),
                 "{n} vs {real}"
             );
         }
@@ -62,7 +63,7 @@ fn gpomdp_is_stable_near_gamma_one() {
     let h = 50_u32;
     let limit = f64::from(h * (h + 1) * (2 * h + 1)) / 6.0;
     let n = gpomdp(&k, 1.0, 0.5, 1.0, h).unwrap();
-    assert!((n as f64 - 2.0 * limit).abs() <= 1.0 + 1e-6 * limit);
+    assert_abs_diff_eq!(n as f64, 2.0 * limit, epsilon = 1.0 + 1e-6 * limit);
 }
 
 /// The printed REINFORCE count R²M²H(γ^H)²/(δε²σ²(1−δ)²) vanishes as H grows; the source's
@@ -108,13 +109,21 @@ fn budget_telescopes_and_gives_theorem_4_1() {
     for (je, jt) in steps {
         b.record_exploratory(je).unwrap();
         b.record_target(jt).unwrap();
-        assert!((b.telescoped_change() - (b.value() - b.initial())).abs() < 1e-12);
-        assert!((b.average_performance() - (je + jt) / 2.0).abs() < 1e-12);
+        assert_abs_diff_eq!(
+            b.telescoped_change(),
+            b.value() - b.initial(),
+            epsilon = 1e-12
+        );
+        assert_abs_diff_eq!(b.average_performance(), (je + jt) / 2.0, epsilon = 1e-12);
         if b.is_type_two_safe() {
             assert!(b.average_performance() >= b.guaranteed_average() - 1e-12);
         }
     }
-    assert!((b.value() - (1.0 + (-8.0 + 10.0) + (-10.5 + 12.0))).abs() < 1e-12);
+    assert_abs_diff_eq!(
+        b.value(),
+        1.0 + (-8.0 + 10.0) + (-10.5 + 12.0),
+        epsilon = 1e-12
+    );
     assert_eq!(b.baseline(), -11.0);
     assert_eq!(b.guaranteed_average(), -11.5);
     assert_eq!(b.required_improvement(), -b.value());
@@ -125,8 +134,8 @@ fn budget_without_target_counts_each_difference_once() {
     let mut b = Budget::new(0.5, -3.0, None).unwrap();
     b.add_exploratory_difference(-0.4).unwrap();
     b.record_exploratory(-3.2).unwrap();
-    assert!((b.value() - 0.3).abs() < 1e-15);
-    assert!((b.telescoped_change() + 0.2).abs() < 1e-15);
+    assert_abs_diff_eq!(b.value(), 0.3, epsilon = 1e-15);
+    assert_abs_diff_eq!(b.telescoped_change(), -0.2, epsilon = 1e-15);
     assert_eq!(b.guaranteed_average(), -3.5);
     assert!(b.is_type_two_safe() && b.average_performance() >= b.guaranteed_average());
     assert!(matches!(

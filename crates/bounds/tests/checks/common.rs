@@ -92,9 +92,10 @@ pub fn golden_max(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// Relative closeness with an absolute floor given by `scale`.
+/// Relative closeness with an absolute floor given by `scale`:
+/// |a − b| ≤ rel · max(|a|, |b|, scale).
 pub fn close(a: f64, b: f64, rel: f64, scale: f64) -> bool {
-    (a - b).abs() <= rel * (a.abs().max(b.abs()).max(scale))
+    approx::relative_eq!(a, b, epsilon = rel * scale, max_relative = rel)
 }
 
 /// A few task-constant sets used across the tests (the `lqg`, `lqg1d` and Mountain Car

@@ -2,6 +2,7 @@
 //! interval against the bound written out here, dominance over Theorem 4.9, and bad input.
 
 use super::common::presets;
+use approx::{assert_relative_eq, relative_eq};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use sepg_bounds::constants::{TaskConstants, d};
@@ -13,10 +14,6 @@ use sepg_bounds::w_update;
 /// B(Δw) = Δw ĝ − |Δw| ε − d Δw², written out independently of the crate.
 fn bound_ref(k: &TaskConstants, sigma: f64, g: f64, eps: f64, dw: f64) -> f64 {
     dw * g - dw.abs() * eps - d(k, sigma).unwrap() * dw * dw
-}
-
-fn close(p: f64, q: f64, rel: f64) -> bool {
-    (p - q).abs() <= rel * p.abs().max(q.abs()).max(f64::MIN_POSITIVE)
 }
 
 #[test]
@@ -31,7 +28,15 @@ fn zero_width_is_theorem_4_5() {
                     match (ours, thesis) {
                         (StepOutcome::Feasible(a), StepOutcome::Feasible(b)) => {
                             for (p, q) in [(a.lo, b.lo), (a.hi, b.hi), (a.c_max, b.c_max)] {
-                                assert!(close(p, q, 1e-12), "{k:?} {g} {l} {required}: {p} vs {q}");
+                                assert!(
+                                    relative_eq!(
+                                        p,
+                                        q,
+                                        epsilon = f64::MIN_POSITIVE,
+                                        max_relative = 1e-12
+                                    ),
+                                    "{k:?} {g} {l} {required}: {p} vs {q}"
+                                );
                             }
                         }
                         (
@@ -43,7 +48,20 @@ fn zero_width_is_theorem_4_5() {
                                 c_max: b,
                                 vertex: w,
                             },
-                        ) => assert!(close(a, b, 1e-12) && close(v, w, 1e-12)),
+                        ) => {
+                            assert_relative_eq!(
+                                a,
+                                b,
+                                epsilon = f64::MIN_POSITIVE,
+                                max_relative = 1e-12
+                            );
+                            assert_relative_eq!(
+                                v,
+                                w,
+                                epsilon = f64::MIN_POSITIVE,
+                                max_relative = 1e-12
+                            );
+                        }
                         (a, b) => panic!("{a:?} vs {b:?} at g = {g}, l = {l}, C = {required}"),
                     }
                 }
@@ -71,7 +89,12 @@ fn interval_end_points_meet_the_requirement() {
                         for (end, out) in [(s.lo, -1.0), (s.hi, 1.0)] {
                             if end != 0.0 {
                                 assert!(
-                                    (f(end) - required).abs() <= 1e-9 * required.abs().max(c_max),
+                                    relative_eq!(
+                                        f(end),
+                                        required,
+                                        epsilon = 1e-9 * c_max,
+                                        max_relative = 1e-9
+                                    ),
                                     "B({end}) = {} ≠ C = {required}",
                                     f(end)
                                 );
@@ -96,7 +119,14 @@ fn infeasible_takes_the_step_of_maximal_guaranteed_improvement() {
     let k = presets()[1];
     let b = ExploringBound::new(&k, 0.5, -0.4, 0.1).unwrap();
     let (vertex, c_max) = b.vertex().unwrap();
-    assert!(vertex < 0.0 && close(c_max, 0.09 / (4.0 * d(&k, 0.5).unwrap()), 1e-14));
+    assert!(
+        vertex < 0.0
+            && relative_eq!(
+                c_max,
+                0.09 / (4.0 * d(&k, 0.5).unwrap()),
+                max_relative = 1e-14
+            )
+    );
     assert_eq!(
         b.safe_interval(2.0 * c_max).unwrap(),
         StepOutcome::Infeasible { c_max, vertex }
@@ -116,7 +146,7 @@ fn infeasible_takes_the_step_of_maximal_guaranteed_improvement() {
     else {
         panic!()
     };
-    assert!(close(beta * -4.0, vertex, 1e-15));
+    assert_relative_eq!(beta * -4.0, vertex, max_relative = 1e-15);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! outcome (4.23), and the sign of the Theorem 4.9 step.
 
 use super::common::presets;
+use approx::{assert_relative_eq, relative_eq};
 use sepg_bounds::high_probability::{
     HighProbabilityBound, HpForm, corrected_norm, v_safe_step, w_safe_step_along_j,
     w_safe_step_along_l,
@@ -18,7 +19,10 @@ fn same(a: StepOutcome, b: StepOutcome) {
                 (x.vertex, y.vertex),
                 (x.c_max, y.c_max),
             ] {
-                assert!((p - q).abs() <= 1e-13 * p.abs().max(q.abs()), "{p} vs {q}");
+                assert!(
+                    relative_eq!(p, q, epsilon = 0.0, max_relative = 1e-13),
+                    "{p} vs {q}"
+                );
             }
         }
         (
@@ -31,7 +35,8 @@ fn same(a: StepOutcome, b: StepOutcome) {
                 vertex: w,
             },
         ) => {
-            assert!((a - b).abs() <= 1e-13 * a.abs() && (v - w).abs() <= 1e-13 * v.abs());
+            assert_relative_eq!(a, b, epsilon = 0.0, max_relative = 1e-13);
+            assert_relative_eq!(v, w, epsilon = 0.0, max_relative = 1e-13);
         }
         (a, b) => panic!("{a:?} vs {b:?}"),
     }

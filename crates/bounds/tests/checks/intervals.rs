@@ -6,6 +6,7 @@
 //! its two terms, so no evaluation can be more accurate than the size of those terms.
 
 use super::common::{c_ref, d_ref, presets, psi_numeric};
+use approx::{assert_abs_diff_eq, assert_relative_eq, relative_eq};
 use sepg_bounds::high_probability::{HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::{SafeInterval, StepOutcome};
 use sepg_bounds::{v_update, w_update};
@@ -15,7 +16,7 @@ pub fn check_interval(bound: &dyn Fn(f64) -> (f64, f64), s: &SafeInterval, requi
     for x in [s.lo, s.hi] {
         let (v, scale) = bound(x);
         assert!(
-            (v - required).abs() <= 1e-10 * scale.max(required.abs()),
+            relative_eq!(v, required, epsilon = 1e-10 * scale, max_relative = 1e-10),
             "B({x}) = {v}, C = {required}"
         );
     }
@@ -64,9 +65,14 @@ fn v_update_interval_4_10() {
                 let s = feasible(v_update::safe_step(&k, sigma, &g, f * c_max).unwrap());
                 check_interval(&bound, &s, f * c_max);
                 let lambda = s.lambda.unwrap();
-                assert!((lambda - (1.0 - f).sqrt()).abs() < 1e-12);
+                assert_abs_diff_eq!(lambda, (1.0 - f).sqrt(), epsilon = 1e-12);
                 let a = v_update::alpha_star(&k, sigma).unwrap();
-                assert!((s.largest() - (1.0 + lambda) * a).abs() <= 1e-12 * s.largest().abs());
+                assert_relative_eq!(
+                    s.largest(),
+                    (1.0 + lambda) * a,
+                    epsilon = 0.0,
+                    max_relative = 1e-12
+                );
             }
         }
     }
@@ -90,7 +96,12 @@ fn w_update_intervals_4_17_and_4_19() {
                     let tilde = w_update::beta_tilde(&k, sigma, gj, gl).unwrap();
                     let lambda = s.lambda.unwrap();
                     let bar = tilde + lambda * tilde.abs();
-                    assert!((s.largest() - bar).abs() <= 1e-12 * bar.abs().max(tilde.abs()));
+                    assert_relative_eq!(
+                        s.largest(),
+                        bar,
+                        epsilon = 1e-12 * tilde.abs(),
+                        max_relative = 1e-12
+                    );
                 }
             }
         }
@@ -105,7 +116,8 @@ fn zero_j_gradient_with_budget() {
     let s = feasible(w_update::safe_step_along_l(&k, 1.0, 0.0, 2.0, -0.5).unwrap());
     assert_eq!(s.lambda, None);
     let half = (0.5 / (dd * 4.0)).sqrt();
-    assert!((s.hi - half).abs() < 1e-14 * half && (s.lo + half).abs() < 1e-14 * half);
+    assert_relative_eq!(s.hi, half, epsilon = 0.0, max_relative = 1e-14);
+    assert_relative_eq!(s.lo, -half, epsilon = 0.0, max_relative = 1e-14);
     assert!(matches!(
         w_update::safe_step_along_l(&k, 1.0, 0.0, 2.0, 0.1).unwrap(),
         StepOutcome::Infeasible { c_max, vertex } if c_max == 0.0 && vertex == 0.0
@@ -172,10 +184,10 @@ fn high_probability_intervals() {
                     check_interval(&aware, &a, required);
                     // same favoured end, never wider than the thesis interval
                     if s > 0.0 {
-                        assert!((a.hi - t.hi).abs() <= 1e-14 * t.hi.abs());
+                        assert_relative_eq!(a.hi, t.hi, epsilon = 0.0, max_relative = 1e-14);
                         assert!(a.lo >= t.lo);
                     } else {
-                        assert!((a.lo - t.lo).abs() <= 1e-14 * t.lo.abs());
+                        assert_relative_eq!(a.lo, t.lo, epsilon = 0.0, max_relative = 1e-14);
                         assert!(a.hi <= t.hi);
                     }
                     // for C < 0 the thesis interval reaches steps whose valid bound is < C

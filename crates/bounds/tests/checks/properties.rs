@@ -1,5 +1,6 @@
 //! Property-based checks over random task constants, gradients and requirements.
 
+use approx::{abs_diff_eq, relative_eq};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use sepg_bounds::budget::Budget;
@@ -87,7 +88,7 @@ proptest! {
             if let StepOutcome::Feasible(s) = o {
                 let l = s.lambda.unwrap();
                 prop_assert_eq!((0.0..=1.0).contains(&l), required >= 0.0);
-                prop_assert!((s.c_max - c_max).abs() <= 1e-12 * c_max);
+                prop_assert!(relative_eq!(s.c_max, c_max, epsilon = 0.0, max_relative = 1e-12));
             }
         }
     }
@@ -105,7 +106,7 @@ proptest! {
         for b in [s.lo, s.hi] {
             let value = w_update::bound_along_l(&k, sigma, gj, gl, b).unwrap();
             let scale = (b * gl * gj).abs().max(dd * b * b * gl * gl).max(required.abs());
-            prop_assert!((value - required).abs() <= 1e-10 * scale, "{} vs {}", value, required);
+            prop_assert!(abs_diff_eq!(value, required, epsilon = 1e-10 * scale), "{} vs {}", value, required);
         }
     }
 
@@ -168,7 +169,7 @@ proptest! {
         for (de, dt) in diffs {
             b.add_exploratory_difference(de).unwrap();
             b.add_target_difference(dt).unwrap();
-            prop_assert!((b.telescoped_change() - (b.value() - b.initial())).abs() < 1e-9);
+            prop_assert!(abs_diff_eq!(b.telescoped_change(), b.value() - b.initial(), epsilon = 1e-9));
             if b.is_type_two_safe() {
                 prop_assert!(b.average_performance() >= b.guaranteed_average() - 1e-9);
             }

@@ -2,6 +2,7 @@
 //! derivative against central finite differences.
 
 use super::common::{c_ref, close, d_ref, golden_max, presets, psi_numeric};
+use approx::assert_abs_diff_eq;
 use sepg_bounds::constants::{c, d, dc_dsigma, psi};
 use sepg_bounds::surrogate::{grad_sigma, grad_w, mixed_from_h, surrogate};
 
@@ -20,8 +21,8 @@ fn lemma_a1_stationary_values_as_printed() {
     let s7 = 7.0_f64.sqrt();
     let x_min = golden_max(|x| -f(x), 0.0, 4.0);
     let x_max = golden_max(f, 4.0, 20.0);
-    assert!((x_min - (4.0 - s7)).abs() < 1e-7);
-    assert!((x_max - (4.0 + s7)).abs() < 1e-7);
+    assert_abs_diff_eq!(x_min, 4.0 - s7, epsilon = 1e-7);
+    assert_abs_diff_eq!(x_max, 4.0 + s7, epsilon = 1e-7);
     assert!(close(
         f(x_min),
         -4.0 * (s7 - 2.0) * (s7 / 2.0 - 2.0).exp(),
@@ -34,8 +35,8 @@ fn lemma_a1_stationary_values_as_printed() {
         1e-13,
         0.0
     ));
-    assert!((f(x_min) + 1.312_362_830_519_112_6).abs() < 1e-14);
-    assert!((f(x_max) - 0.669_899_090_567_421_5).abs() < 1e-14);
+    assert_abs_diff_eq!(f(x_min), -1.312_362_830_519_112_6, epsilon = 1e-14);
+    assert_abs_diff_eq!(f(x_max), 0.669_899_090_567_421_5, epsilon = 1e-14);
 }
 
 #[test]

@@ -5,6 +5,7 @@ use super::common::{
     c_ref, close, d_ref, golden_max, k_mu_numeric, k_w_numeric, presets, psi_numeric,
 };
 use super::intervals::check_interval;
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{rigorous, w_update};
@@ -111,7 +112,7 @@ fn gaussian_constants_match_the_high_precision_table() {
         for (s, active_box) in [(0.99 * sw, true), (1.01 * sw, false)] {
             let (v, scale) = f_ref(&k0, s, 0.3, 1e-3, psi);
             let got = rigorous::bound(&k0, s, 0.3, 1e-3).unwrap();
-            assert!((got - v).abs() <= 1e-12 * scale);
+            assert_abs_diff_eq!(got, v, epsilon = 1e-12 * scale);
             let gap = rigorous::gap(&k0, s, 1e-3).unwrap();
             assert_eq!(gap > 0.0, !active_box, "σ = {s}: gap {gap}");
         }
@@ -132,10 +133,13 @@ fn bound_matches_definition() {
             for x in [-0.5, -0.05, -1e-3, 1e-3, 0.05, 0.5] {
                 let (v, scale) = f_ref(&k, sigma, 0.7, x, psi);
                 let got = rigorous::bound(&k, sigma, 0.7, x).unwrap();
-                assert!((got - v).abs() <= 1e-12 * scale, "{got} vs {v} at {x}");
+                assert!(
+                    abs_diff_eq!(got, v, epsilon = 1e-12 * scale),
+                    "{got} vs {v} at {x}"
+                );
                 let thesis = rigorous::thesis_bound(&k, sigma, 0.7, x).unwrap();
                 let gap = rigorous::gap(&k, sigma, x).unwrap();
-                assert!((thesis - got - gap).abs() <= 1e-12 * scale);
+                assert_abs_diff_eq!(thesis - got, gap, epsilon = 1e-12 * scale);
             }
         }
     }

@@ -1,4 +1,4 @@
-"""Every closed-form quantity of the Rust crate ``sepg-bounds``.
+"""Every quantity of the Rust crate ``sepg-bounds``.
 
 Each function is named ``<module>_<function>`` after its Rust path, e.g.
 ``v_update::safe_step`` is :func:`v_update_safe_step`. The thesis reference of each is in its
@@ -16,7 +16,14 @@ prefix                        thesis
 ``surrogate_``                Corollary 4.4, Appendix B
 ``high_probability_``         Theorems 4.7-4.9, eqs. (4.23)-(4.30)
 ``greedy_``                   Section 4.3.4
-``rigorous_``                 Theorem 4.3 without neglected terms (Lemmas A.1-A.3)
+``rigorous_``                 Theorem 4.3 without neglected terms (Lemmas A.1-A.3), and
+                              Theorem 4.2 with c sound on the real line (K_W, K_MU)
+``exploring_``,               the exploring w-update: Theorem 4.3 on the confidence
+:class:`ExploringBound`       event of grad_w J (Assumption 4.6)
+``certified_``,               certified steps: Theorems 4.2-4.9, the rigorous and the
+:class:`Interval`,            exploring bounds evaluated in outward-rounded interval
+:class:`Enclosure`,           arithmetic; the outcome "uncertifiable" when C is within
+:class:`Certified`            rounding of C_max (docs/THEOREMS.md, "Certified steps")
 ``budget_``, :class:`Budget`  Definition 4.3, Theorem 4.1, eqs. (4.13)-(4.14)
 ============================  ==========================================================
 
@@ -25,16 +32,34 @@ Invalid input raises :class:`sepg.errors.InvalidInputError` (a ``ValueError``).
 
 from sepg._native import (
     Budget,
+    Certified,
+    Enclosure,
+    ExploringBound,
     HighProbabilityBound,
+    Interval,
     StepOutcome,
     TaskConstants,
     batch_size_gpomdp,
     batch_size_reinforce,
     budget_split_requirement,
+    certified_c,
+    certified_d,
+    certified_exploring_safe_step,
+    certified_hp_v_safe_step,
+    certified_hp_w_safe_step_along_j,
+    certified_hp_w_safe_step_along_l,
+    certified_psi,
+    certified_rigorous_safe_step_along_j,
+    certified_rigorous_safe_step_along_l,
+    certified_sqrt_2pi,
+    certified_v_safe_step,
+    certified_w_safe_step_along_j,
+    certified_w_safe_step_along_l,
     constants_c,
     constants_d,
     constants_dc_dsigma,
     constants_psi,
+    exploring_w_exploring_step,
     greedy_argmax_abs,
     greedy_coordinate_update,
     greedy_v_step,
@@ -50,12 +75,17 @@ from sepg._native import (
     pirotta_hp_optimal_step,
     pirotta_optimal_step,
     rigorous_bound,
+    rigorous_c,
     rigorous_gap,
+    rigorous_k_mu,
+    rigorous_k_w,
     rigorous_kl2,
     rigorous_safe_delta_w,
     rigorous_safe_step_along_j,
     rigorous_safe_step_along_l,
     rigorous_thesis_bound,
+    rigorous_v_bound,
+    rigorous_v_safe_step,
     surrogate_grad_sigma,
     surrogate_grad_w,
     surrogate_mixed_from_h,
@@ -75,16 +105,34 @@ from sepg._native import (
 
 __all__ = [
     "Budget",
+    "Certified",
+    "Enclosure",
+    "ExploringBound",
     "HighProbabilityBound",
+    "Interval",
     "StepOutcome",
     "TaskConstants",
     "batch_size_gpomdp",
     "batch_size_reinforce",
     "budget_split_requirement",
+    "certified_c",
+    "certified_d",
+    "certified_exploring_safe_step",
+    "certified_hp_v_safe_step",
+    "certified_hp_w_safe_step_along_j",
+    "certified_hp_w_safe_step_along_l",
+    "certified_psi",
+    "certified_rigorous_safe_step_along_j",
+    "certified_rigorous_safe_step_along_l",
+    "certified_sqrt_2pi",
+    "certified_v_safe_step",
+    "certified_w_safe_step_along_j",
+    "certified_w_safe_step_along_l",
     "constants_c",
     "constants_d",
     "constants_dc_dsigma",
     "constants_psi",
+    "exploring_w_exploring_step",
     "greedy_argmax_abs",
     "greedy_coordinate_update",
     "greedy_v_step",
@@ -100,12 +148,17 @@ __all__ = [
     "pirotta_hp_optimal_step",
     "pirotta_optimal_step",
     "rigorous_bound",
+    "rigorous_c",
     "rigorous_gap",
+    "rigorous_k_mu",
+    "rigorous_k_w",
     "rigorous_kl2",
     "rigorous_safe_delta_w",
     "rigorous_safe_step_along_j",
     "rigorous_safe_step_along_l",
     "rigorous_thesis_bound",
+    "rigorous_v_bound",
+    "rigorous_v_safe_step",
     "surrogate_grad_sigma",
     "surrogate_grad_w",
     "surrogate_mixed_from_h",

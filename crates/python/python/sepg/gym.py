@@ -176,6 +176,14 @@ class _Collector:
         self.seconds += time.perf_counter() - start
         return record
 
+    @staticmethod
+    def _means(mean: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """V phi(s) for one feature vector (shape (p,)) or a stack of them (shape (k, p)),
+        with the same products and sums either way, so that a vector environment collects
+        the trajectories of a single one bit for bit (a matrix product would not: BLAS
+        kernels round differently for a vector and a matrix)."""
+        return (mean * phi[..., None, :]).sum(axis=-1)
+
     def _single(self, req: BatchRequest, i: int, mean: np.ndarray, sigma: Optional[np.ndarray], record: Any) -> None:
         rewards, actions, feats, lengths = record
         obs, _ = self.env.reset(seed=int(req.env_seeds[i]))
@@ -183,7 +191,7 @@ class _Collector:
         t = 0
         while t < self.horizon:
             phi = self.phi(obs)
-            a = mean @ phi
+            a = self._means(mean, phi)
             if sigma is not None:
                 a = a + sigma * rng.standard_normal(self.actions)
             obs, r, terminated, truncated, _ = self.env.step(a)
@@ -207,7 +215,7 @@ class _Collector:
         lengths[first:end] = self.horizon
         for t in range(self.horizon):
             phi = np.stack([self.phi(o) for o in obs])
-            a = phi @ mean.T
+            a = self._means(mean, phi)
             if sigma is not None:
                 noise = np.zeros((k, self.actions))
                 for j in range(m):
@@ -235,7 +243,9 @@ class GymRun:
     is named as on the command line (``sepg-zv``, ``sepg-lv``, ``sepg-mi``, ``sepg-lb1``,
     ``sepg-lb2``, ``sepg-sim``, ``sepg-naive-w``, ``gpomdp-const``, ``gpomdp-adam``,
     ``adastep``); ``options`` are its hyper-parameters (``nu``, ``requirement``, ``alpha``,
-    ``beta``, ``lr``, ``lr_w``). ``horizon`` defaults to the environment's
+    ``beta``, ``lr``, ``lr_w``) and ``reference_batch``, the N0 trajectories that estimate
+    J(theta^0) before SEPG's first iteration (default 1000; 0 takes it from the first
+    v-block, as the thesis's pseudocode). ``horizon`` defaults to the environment's
     ``max_episode_steps``.
     """
 

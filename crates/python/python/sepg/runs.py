@@ -138,6 +138,12 @@ def _engine(engine: str) -> str:
         return "local"
 
 
+def _sweep_run(out: str, index: int, checkpoint_every: int) -> str:
+    """Run ``index`` of the sweep folder ``out``: the task that Dask or Ray map (a Python
+    function, which Ray's ``remote`` needs and a worker process imports by name)."""
+    return os.fspath(_native.sweep_run(out, index, checkpoint_every))
+
+
 def sweep(
     spec: Union[PathLike, Dict[str, Any]],
     out: PathLike,
@@ -162,14 +168,13 @@ def sweep(
     if chosen == "dask":
         import dask
 
-        dask.compute(*[dask.delayed(_native.sweep_run)(out, i, checkpoint_every) for i in indices])
+        dask.compute(*[dask.delayed(_sweep_run)(out, i, checkpoint_every) for i in indices])
     else:
         import ray
 
-        task = ray.remote(_native.sweep_run)
+        task = ray.remote(_sweep_run)
         ray.get([task.remote(out, i, checkpoint_every) for i in indices])
-    with open(os.path.join(out, "sweep.json")) as f:
-        return json.load(f)
+    return json.loads(_native.sweep_finish(out))
 
 
 def merge(shards: Sequence[PathLike], out: PathLike, *, force: bool = False) -> Dict[str, Any]:

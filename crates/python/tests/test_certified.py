@@ -1,0 +1,266 @@
+"""The certified steps, interval arithmetic, the exploring w-update and the rigorous
+constants of ``sepg.bounds``, against values computed here independently: numerical
+integrals, closed forms by hand, 50-digit decimal arithmetic, and the command line's
+``sepg bounds --json --certified``."""
+
+import json
+import math
+import pathlib
+import subprocess
+from decimal import Decimal, getcontext
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import sepg
+from sepg import bounds
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+CLI = ROOT / "target" / "release" / "sepg"
+K = sepg.TaskConstants(0.9, 2.0, 1.5, 3.0)
+
+getcontext().prec = 50
+# pi to 50 digits, so that sqrt(2 pi) and c(sigma) are known far beyond double precision.
+PI = Decimal("3.14159265358979323846264338327950288419716939937510")
+
+
+def simpson(f, a, b, n=20000):
+    x = np.linspace(a, b, n + 1)
+    y = f(x)
+    return (b - a) / (3 * n) * (y[0] + y[-1] + 4 * y[1:-1:2].sum() + 2 * y[2:-1:2].sum())
+
+
+def phi(z):
+    return np.exp(-0.5 * z * z) / math.sqrt(2 * math.pi)
+
+
+def integral_abs(poly, roots):
+    """The integral over the real line of |poly(z)| phi(z), by Simpson's rule between the
+    sign changes of poly (where |poly| is smooth) and out to |z| = 12 (the tail is < 1e-30)."""
+    cuts = sorted({-12.0, 12.0, *roots, *(-r for r in roots)})
+    return sum(simpson(lambda z: np.abs(poly(z)) * phi(z), a, b) for a, b in zip(cuts, cuts[1:]))
+
+
+def test_rigorous_constants_are_the_integrals_they_stand_for():
+    z1, z2 = math.sqrt(2 - math.sqrt(3)), math.sqrt(2 + math.sqrt(3))
+    k_w = integral_abs(lambda z: z**4 - 4 * z**2 + 1, [z1, z2])
+    k_mu = integral_abs(lambda z: z**2 - 1, [1.0])
+    # Simpson's error with 20000 panels per piece is far below 1e-11 here.
+    assert bounds.rigorous_k_w() == pytest.approx(k_w, rel=1e-11)
+    assert bounds.rigorous_k_mu() == pytest.approx(k_mu, rel=1e-11)
+    assert bounds.rigorous_k_mu() == pytest.approx(4 * math.exp(-0.5) / math.sqrt(2 * math.pi), rel=1e-15)
+
+
+def c_real_line(k, sigma):
+    # c_R(sigma) = R M^2 / ((1 - g)^2 sigma^2) (max(|A| / (sqrt(2 pi) sigma), K_MU) + g / (2 (1 - g)))
+    g = k.gamma
+    box = k.action_volume / (math.sqrt(2 * math.pi) * sigma)
+    k_mu = 4 * math.exp(-0.5) / math.sqrt(2 * math.pi)
+    return k.r_max * k.m_phi**2 / ((1 - g) ** 2 * sigma**2) * (max(box, k_mu) + g / (2 * (1 - g)))
+
+
+def test_rigorous_c_and_v_steps_match_the_closed_form():
+    # The box term wins below sigma = |A| e^(1/2) / 4 = 1.2365 for |A| = 3, K_MU above.
+    threshold = K.action_volume * math.exp(0.5) / 4
+    for sigma in (0.3, 1.0, threshold * 1.01, 3.0):
+        assert bounds.rigorous_c(K, sigma) == pytest.approx(c_real_line(K, sigma), rel=1e-13)
+        if sigma < threshold:
+            assert bounds.rigorous_c(K, sigma) == bounds.constants_c(K, sigma)
+        else:
+            assert bounds.rigorous_c(K, sigma) > bounds.constants_c(K, sigma)
+    sigma, grad = 3.0, np.array([0.2, -0.6])
+    c, n2 = c_real_line(K, sigma), 0.36
+    assert bounds.rigorous_v_bound(K, sigma, grad, 1e-3) == pytest.approx(1e-3 * n2 - 1e-6 * c * n2, rel=1e-12)
+    o = bounds.rigorous_v_safe_step(K, sigma, grad, 0.25 * n2 / (4 * c))
+    vertex, lam = 1 / (2 * c), math.sqrt(1 - 0.25)
+    assert o.kind == "feasible"
+    assert o.vertex == pytest.approx(vertex, rel=1e-13) and o.c_max == pytest.approx(n2 / (4 * c), rel=1e-13)
+    assert (o.lo, o.hi) == pytest.approx(((1 - lam) * vertex, (1 + lam) * vertex), rel=1e-12)
+
+
+def d_closed_form(k, sigma):
+    psi = 4 * (math.sqrt(7) - 2) * math.exp(math.sqrt(7) / 2 - 2) / math.sqrt(2 * math.pi)
+    g = k.gamma
+    return k.r_max / (1 - g) ** 2 * (psi * k.action_volume / (2 * sigma) + g / (1 - g))
+
+
+def exploring_interval(g, eps, d, required):
+    """{dw : dw g - |dw| eps - d dw^2 >= C}, by hand: on dw >= 0 the parabola
+    dw (g - eps) - d dw^2, on dw <= 0 the parabola dw (g + eps) - d dw^2; each root by the
+    quadratic formula."""
+    def roots(a):
+        disc = a * a - 4 * d * required
+        return ((a - math.sqrt(disc)) / (2 * d), (a + math.sqrt(disc)) / (2 * d))
+
+    lo = roots(g + eps)[0]  # the negative root of the left parabola (C < 0)
+    hi = roots(g - eps)[1]  # the positive root of the right parabola
+    return lo, hi
+
+
+def test_the_exploring_bound_and_step_match_the_closed_form():
+    sigma, g, eps, gl, required = 1.0, -0.3, 0.1, 0.4, -0.01
+    d = d_closed_form(K, sigma)
+    b = bounds.ExploringBound(K, sigma, g, eps)
+    assert b.d == pytest.approx(d, rel=1e-13)
+    for dw in (-0.01, 0.0, 0.02):
+        assert b.value(dw) == pytest.approx(dw * g - abs(dw) * eps - d * dw * dw, rel=1e-13, abs=1e-300)
+    a = abs(g) - eps
+    assert b.vertex() == pytest.approx((-a / (2 * d), a * a / (4 * d)), rel=1e-13)
+    lo, hi = exploring_interval(g, eps, d, required)
+    s = b.safe_interval(required)
+    assert s.kind == "feasible" and (s.lo, s.hi) == pytest.approx((lo, hi), rel=1e-12)
+    # The step: beta = dw / grad_w_l_hat, the end furthest along grad_w_l_hat.
+    step = bounds.exploring_w_exploring_step(K, sigma, g, eps, gl, required)
+    assert step.chosen_step == pytest.approx(hi / gl, rel=1e-12)
+    # Theorem 4.9 makes no update when grad_w_l_hat is within its width, the exploring step does.
+    assert bounds.high_probability_w_safe_step_along_l(K, sigma, g, eps, gl, 0.5, required).kind == "below_noise"
+    # With eps_J = 0 it is the interval of eq. (4.19).
+    exact = bounds.exploring_w_exploring_step(K, sigma, g, 0.0, gl, required)
+    thesis = bounds.w_update_safe_step_along_l(K, sigma, g, gl, required)
+    assert (exact.lo, exact.hi) == pytest.approx((thesis.lo, thesis.hi), rel=1e-12)
+    assert bounds.exploring_w_exploring_step(K, sigma, g, eps, 0.0, required).kind == "zero_gradient"
+
+
+def c_decimal(k, sigma):
+    """c(sigma) of Theorem 4.2 in 50-digit decimal arithmetic, from the exact values of the
+    floats k and sigma."""
+    g, r, m, a, s = (Decimal(x) for x in (k.gamma, k.r_max, k.m_phi, k.action_volume, sigma))
+    one = Decimal(1)
+    return r * m * m / ((one - g) ** 2 * s * s) * (a / ((2 * PI).sqrt() * s) + g / (2 * (one - g)))
+
+
+def v_bound_decimal(k, sigma, grad, x):
+    n2 = Decimal(max(abs(v) for v in grad)) ** 2
+    x = Decimal(x)
+    return x * n2 - x * x * c_decimal(k, sigma) * n2
+
+
+def test_a_certified_v_step_meets_its_requirement_in_50_digit_arithmetic():
+    sigma, grad = 0.7, [0.3, -0.8]
+    cmax = bounds.v_update_c_max(K, sigma, grad)
+    for required in (-0.01, 0.0, 0.5 * cmax, 0.999999 * cmax):
+        o = bounds.certified_v_safe_step(K, sigma, grad, required)
+        assert o.kind == "step" and o.is_certified
+        exact = v_bound_decimal(K, sigma, grad, o.chosen_step)
+        assert exact >= Decimal(required)
+        assert Decimal(o.bound.lo) <= exact <= Decimal(o.bound.hi)
+        assert o.bound.lo >= required
+        # The float interval's largest step, moved toward the vertex by ulps_moved ulps.
+        assert o.interval.vertex <= o.chosen_step <= o.interval.hi
+        assert (o.chosen_step == o.interval.hi) == (o.ulps_moved == 0)
+
+
+def test_a_requirement_at_c_max_is_uncertifiable():
+    sigma, grad = 1.0, [0.8]
+    cmax = bounds.v_update_c_max(K, sigma, grad)
+    o = bounds.certified_v_safe_step(K, sigma, grad, cmax)
+    assert o.kind == "uncertifiable" and not o.is_certified
+    assert o.chosen_step == pytest.approx(bounds.v_update_alpha_star(K, sigma), rel=1e-15)
+    exact = v_bound_decimal(K, sigma, grad, o.chosen_step)
+    assert Decimal(o.bound.lo) <= exact <= Decimal(o.bound.hi) and o.bound.lo < cmax
+    assert bounds.certified_v_safe_step(K, sigma, grad, 1.01 * cmax).kind == "infeasible"
+    assert bounds.certified_v_safe_step(K, sigma, [0.0], -1.0).kind == "zero_gradient"
+    assert bounds.certified_v_safe_step(K, sigma, [0.0], -1.0).requirement_met is True
+    assert bounds.certified_hp_v_safe_step(K, sigma, grad, 1.0, 0.0).kind == "below_noise"
+
+
+def test_the_enclosures_contain_the_exact_values():
+    sqrt_2pi = (2 * PI).sqrt()
+    assert Decimal(bounds.certified_sqrt_2pi().lo) <= sqrt_2pi <= Decimal(bounds.certified_sqrt_2pi().hi)
+    for sigma in (0.1, 0.7, 5.0):
+        c = bounds.certified_c(K, sigma)
+        assert Decimal(c.lo) <= c_decimal(K, sigma) <= Decimal(c.hi)
+        assert c.width <= 1e-13 * c.hi
+        assert bounds.certified_d(K, sigma).contains(bounds.constants_d(K, sigma))
+    # psi = 4 (sqrt 7 - 2) exp(sqrt 7 / 2 - 2) / sqrt(2 pi), in 50 digits.
+    r7 = Decimal(7).sqrt()
+    psi = 4 * (r7 - 2) * (r7 / 2 - 2).exp() / sqrt_2pi
+    assert Decimal(bounds.certified_psi().lo) <= psi <= Decimal(bounds.certified_psi().hi)
+
+
+def test_interval_arithmetic_rounds_outward():
+    third = bounds.Interval.point(0.1) / 3.0
+    exact = Fraction(0.1) / 3
+    assert Fraction(third.lo) <= exact <= Fraction(third.hi) and third.lo < third.hi
+    r = bounds.Interval.point(2.0).sqrt()
+    assert Fraction(r.lo) ** 2 <= 2 <= Fraction(r.hi) ** 2
+    s = 1.0 + bounds.Interval(0.1, 0.2) * 3 - bounds.Interval.point(0.3)
+    assert Fraction(s.lo) <= 1 + Fraction(0.1) * 3 - Fraction(0.3)
+    assert 1 + Fraction(0.2) * 3 - Fraction(0.3) <= Fraction(s.hi)
+    assert bounds.Interval(-1.0, 2.0).sqr().lo == 0.0
+    assert (bounds.Interval.point(1.0) / bounds.Interval(-1.0, 1.0)).lo == -math.inf
+    with pytest.raises(sepg.InvalidInputError):
+        bounds.Interval(2.0, 1.0)
+    with pytest.raises(sepg.InvalidInputError):
+        bounds.Interval.point(math.nan)
+    with pytest.raises(sepg.InvalidInputError):
+        bounds.Interval.point(1.0) + "one"
+
+
+def test_an_enclosure_certifies_the_float_outcome_of_its_bound():
+    sigma, g, gl, required = 1.0, 0.3, -2.0, -0.1
+    e = bounds.Enclosure.quadratic_w_along_l(K, sigma, g, gl)
+    o = e.certify(bounds.w_update_safe_step_along_l(K, sigma, g, gl, required), required)
+    direct = bounds.certified_w_safe_step_along_l(K, sigma, g, gl, required)
+    assert (o.kind, o.chosen_step, o.bound) == (direct.kind, direct.chosen_step, direct.bound)
+    # The bound of a step beta along grad_w_l: beta L J - beta^2 d L^2.
+    d = d_closed_form(K, sigma)
+    beta = o.chosen_step
+    assert e.enclose(beta).contains(beta * gl * g - beta**2 * d * gl**2) or math.isclose(
+        e.enclose(beta).lo, beta * gl * g - beta**2 * d * gl**2, rel_tol=1e-12
+    )
+    step, bound, ulps = e.certify_toward(o.interval.lo, o.interval.vertex, required)
+    assert step is not None and bound.lo >= required and ulps >= 0
+    x = bounds.Enclosure.exploring(K, sigma, -0.3, 0.1, 0.4)
+    ex = x.certify(bounds.exploring_w_exploring_step(K, sigma, -0.3, 0.1, 0.4, -0.01), -0.01)
+    assert ex == ex and ex.is_certified
+    assert ex.chosen_step == bounds.certified_exploring_safe_step(K, sigma, -0.3, 0.1, 0.4, -0.01).chosen_step
+    assert bounds.Enclosure.hp_v_update(K, sigma, [0.1], 0.2) is None
+    r = bounds.Enclosure.rigorous(K, sigma, 0.5, 0.5)
+    assert r.enclose(-0.2).contains(bounds.rigorous_bound(K, sigma, 0.5, -0.1)) or r.enclose(-0.2).lo <= bounds.rigorous_bound(K, sigma, 0.5, -0.1)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: bounds.certified_v_safe_step(K, math.nan, [0.5], 0.0),
+        lambda: bounds.certified_v_safe_step(K, 1.0, [math.inf], 0.0),
+        lambda: bounds.certified_hp_v_safe_step(K, 1.0, [0.5], 0.1, 0.0, form="other"),
+        lambda: bounds.certified_exploring_safe_step(K, 1.0, 0.3, -0.1, 0.4, 0.0),
+        lambda: bounds.certified_hp_w_safe_step_along_l(K, 1.0, (math.nan, 0.1), (0.4, 0.1), 0.0),
+        lambda: bounds.ExploringBound(K, -1.0, 0.3, 0.1),
+        lambda: bounds.rigorous_c(K, 0.0),
+        lambda: bounds.Enclosure.quadratic_v_update(K, 1.0, []),
+        lambda: bounds.Enclosure.quadratic_w_along_j(K, 1.0, 0.3).enclose(math.nan),
+        lambda: bounds.Enclosure.quadratic_w_along_j(K, 1.0, 0.3).certify(
+            bounds.w_update_safe_step_along_j(K, 1.0, 0.3, 0.0), math.inf
+        ),
+    ],
+)
+def test_bad_input_raises_one_typed_value_error(call):
+    with pytest.raises(sepg.InvalidInputError):
+        call()
+
+
+@pytest.mark.skipif(not CLI.is_file(), reason="the sepg binary is built by `bash scripts/test.sh`")
+def test_the_certified_steps_are_those_of_the_command_line():
+    k, sigma, gv, gw, gl, req = sepg.TaskConstants(0.9, 2.0, 1.5, 3.0), 0.7, [0.3, -0.8], 0.4, -1.2, -0.01
+    out = subprocess.run(
+        [str(CLI), "bounds", "--gamma", "0.9", "--r-max", "2", "--m-phi", "1.5", "--action-volume", "3",
+         "--sigma", "0.7", "--grad-v", "0.3,-0.8", "--grad-w", "0.4", "--grad-w-l", "-1.2",
+         "--required", "-0.01", "--json", "--certified"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    cli = json.loads(out)["certified"]
+    enc = cli["enclosures"]
+    for name, ours in (("psi", bounds.certified_psi()), ("c", bounds.certified_c(k, sigma)), ("d", bounds.certified_d(k, sigma))):
+        assert [ours.lo, ours.hi] == enc[name]
+    for name, ours in (
+        ("alpha_bar", bounds.certified_v_safe_step(k, sigma, gv, req)),
+        ("beta_bar_j", bounds.certified_w_safe_step_along_j(k, sigma, gw, req)),
+        ("beta_bar", bounds.certified_w_safe_step_along_l(k, sigma, gw, gl, req)),
+    ):
+        step = cli["steps"][name]
+        assert step["outcome"] == "certified" and ours.is_certified
+        assert step["step"] == ours.chosen_step and step["bound"] == [ours.bound.lo, ours.bound.hi]
