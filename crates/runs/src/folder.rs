@@ -291,7 +291,7 @@ pub struct Summary {
     pub constants: UsedConstants,
 }
 
-/// The task constants γ, R, M_φ, |A| a run's bounds used (after the overrides).
+/// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct UsedConstants {
     /// Discount factor γ.
@@ -302,6 +302,10 @@ pub struct UsedConstants {
     pub m_phi: f64,
     /// Action-space volume |A|.
     pub action_volume: f64,
+    /// ψ of Lemma A.1 in d (Theorem 4.3): 0.523557 unless overridden (absent from the
+    /// summaries of older versions, which always used that value).
+    #[serde(default = "sepg_bounds::constants::psi")]
+    pub psi: f64,
 }
 
 /// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.

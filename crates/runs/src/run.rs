@@ -281,6 +281,7 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
                 r_max: k.r_max(),
                 m_phi: k.m_phi(),
                 action_volume: k.action_volume(),
+                psi: k.psi_used(),
             }
         },
     };

@@ -465,6 +465,11 @@ pub struct RunSpec {
     )]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub action_volume: Option<f64>,
+    /// ψ of Lemma A.1 used by the bound of Theorem 4.3 [default: 0.523557; the thesis-era
+    /// code used 0.53]; the bounds hold for ψ ≥ 0.523557.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub psi: Option<f64>,
 }
 
 macro_rules! overlay_fields {
@@ -481,7 +486,7 @@ impl RunSpec {
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
             estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
             metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
-            reference_batch, gamma, r_max, m_phi, action_volume)
+            reference_batch, gamma, r_max, m_phi, action_volume, psi)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -697,6 +702,7 @@ impl RunSpec {
             r_max: self.r_max,
             m_phi: self.m_phi,
             action_volume: self.action_volume,
+            psi: self.psi,
         };
         let defaults = SepgOptions::default();
         if !algo.is_sepg() {
@@ -855,6 +861,7 @@ impl RunSpec {
             r_max: o.overrides.r_max,
             m_phi: o.overrides.m_phi,
             action_volume: o.overrides.action_volume,
+            psi: o.overrides.psi,
             ..RunSpec::default()
         };
         let (sepg, naive, lb1) = match method.algorithm {
@@ -1125,6 +1132,7 @@ mod tests {
             reference_batch: Some(0),
             gamma: Some(0.9),
             r_max: Some(30.0),
+            psi: Some(0.53),
             ..RunSpec::default()
         };
         let once = spec.resolve().expect("valid");
@@ -1137,11 +1145,13 @@ mod tests {
         assert_eq!(o.reference_batch, 0);
         assert_eq!(once.checked.constants().gamma(), 0.9);
         assert_eq!(once.checked.constants().r_max(), 30.0);
+        assert_eq!(once.checked.constants().psi_override(), Some(0.53));
         assert_eq!(once.spec.m_phi, None);
         let text = once.toml().expect("toml");
         assert!(
             text.contains("w-step = \"theorem-4.9\"") && text.contains("quantile-factor = 2.0")
         );
+        assert!(text.contains("psi = 0.53"), "{text}");
         let again: RunSpec = toml::from_str(&text).expect("parse");
         let twice = again.resolve().expect("valid");
         assert_eq!(once.spec, twice.spec);
@@ -1157,6 +1167,7 @@ mod tests {
         assert_eq!(plain.spec.confidence, Some(ConfidenceName::StudentT));
         assert_eq!(plain.spec.reference_batch, Some(1000));
         assert_eq!(plain.spec.lb1_requirement, None);
+        assert_eq!(plain.checked.constants().psi_override(), None);
     }
 
     #[test]
