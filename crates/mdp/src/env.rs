@@ -104,6 +104,19 @@ pub trait Environment: Sync {
     ) -> (f64, bool);
     /// The policy features `φ(s)` into `phi` (length `p`).
     fn features(&self, state: &[f64], phi: &mut [f64]);
+    /// Component `j` of the action that [`Environment::step`] applies for the raw action
+    /// component `a`: `a` clipped to the action box `[a_low_j, a_high_j]`, or `a` itself for an
+    /// environment without an action box (the default). Used by the scores on clipped actions
+    /// ([`crate::rollout::ScoreAction::Clipped`]).
+    ///
+    /// ```
+    /// use sepg_mdp::env::{Environment, LqgEnv};
+    /// assert_eq!(LqgEnv::lqg1d().clip_action(0, 7.5), 4.0);
+    /// ```
+    fn clip_action(&self, j: usize, a: f64) -> f64 {
+        let _ = j;
+        a
+    }
     /// The scalar LQG behind this environment, if it is one: rollouts then run a fused
     /// specialised kernel with identical results.
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
@@ -332,6 +345,16 @@ impl Environment for LqgEnv {
         phi.copy_from_slice(state);
     }
 
+    /// `a` clipped to `[action_low_j, action_high_j]` when the model clips, else `a`.
+    fn clip_action(&self, j: usize, a: f64) -> f64 {
+        let m = &self.model;
+        if m.clipping {
+            a.clamp(m.action_low[j], m.action_high[j])
+        } else {
+            a
+        }
+    }
+
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {
         self.scalar.is_some().then_some(self)
     }
@@ -482,6 +505,10 @@ impl Environment for AnyEnv {
 
     fn features(&self, state: &[f64], phi: &mut [f64]) {
         dispatch!(self, e => e.features(state, phi))
+    }
+
+    fn clip_action(&self, j: usize, a: f64) -> f64 {
+        dispatch!(self, e => e.clip_action(j, a))
     }
 
     fn as_scalar_lqg(&self) -> Option<&LqgEnv> {

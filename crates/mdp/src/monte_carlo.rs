@@ -35,7 +35,7 @@ use rayon::prelude::*;
 use crate::env::Environment;
 use crate::policy::GaussianPolicy;
 use crate::rng::SeedKey;
-use crate::rollout::{RolloutError, Scratch};
+use crate::rollout::{RolloutError, ScoreAction, Scratch};
 use crate::stream::{StepBaseline, Streamer};
 
 /// Number of consecutive trajectories in one streamed work item.
@@ -364,7 +364,7 @@ pub fn stream_returns<E: Environment + ?Sized>(
     if n == 0 {
         return Err(McError::TooFewSamples(0));
     }
-    let s = Streamer::new(env, policy, horizon, key)?;
+    let s = Streamer::new(env, policy, horizon, key, ScoreAction::Raw)?;
     let (m, steps) = stream(&s, n, 1, |first, _, out, w| {
         s.returns(first, out, &mut w.sc)
     })?;
@@ -431,15 +431,45 @@ pub fn stream_gradients<E: Environment + ?Sized>(
     key: SeedKey,
     pilot: usize,
 ) -> Result<GradientMoments, McError> {
+    stream_gradients_with(env, policy, n, horizon, key, pilot, ScoreAction::Raw)
+}
+
+/// [`stream_gradients`] with the scores (of the pilot batch and of the `n` trajectories)
+/// evaluated at the action chosen by `score` ([`ScoreAction::Raw`] is exactly
+/// [`stream_gradients`]; with [`ScoreAction::Clipped`] the gradient estimates are biased where
+/// the action box clips).
+///
+/// # Formula
+/// ```text
+/// as stream_gradients, with S^v, S^w the cumulative scores of the action chosen by score
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey};
+/// use sepg_mdp::{monte_carlo::stream_gradients_with, rollout::ScoreAction};
+/// let pi = GaussianPolicy::scalar(-0.3, 0.5f64.ln()).unwrap();
+/// let (env, key) = (LqgEnv::lqg1d(), SeedKey::new(1, 0, 0));
+/// let g = stream_gradients_with(&env, &pi, 500, 20, key, 100, ScoreAction::Clipped).unwrap();
+/// assert_eq!(g.j.count(), 500);
+/// ```
+pub fn stream_gradients_with<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+    pilot: usize,
+    score: ScoreAction,
+) -> Result<GradientMoments, McError> {
     if n == 0 {
         return Err(McError::TooFewSamples(0));
     }
     if policy.is_deterministic() {
         return Err(McError::Rollout(RolloutError::DeterministicPolicy));
     }
-    let s = Streamer::new(env, policy, horizon, key)?;
+    let s = Streamer::new(env, policy, horizon, key, score)?;
     let baseline =
-        fit_baseline(env, policy, horizon, key, pilot)?.unwrap_or_else(|| s.zero_baseline());
+        fit_baseline(env, policy, horizon, key, pilot, score)?.unwrap_or_else(|| s.zero_baseline());
     let (dv, dw) = (s.dim_v(), s.dim_w());
     let (m, steps) = stream(&s, n, 1 + dv + dw, |first, count, out, w| {
         s.gpomdp(first, count, &baseline, out, &mut w.sc)
@@ -461,11 +491,12 @@ fn fit_baseline<E: Environment + ?Sized>(
     horizon: usize,
     key: SeedKey,
     pilot: usize,
+    score: ScoreAction,
 ) -> Result<Option<StepBaseline>, McError> {
     if pilot == 0 {
         return Ok(None);
     }
-    let s = Streamer::new(env, policy, horizon, pilot_key(key))?;
+    let s = Streamer::new(env, policy, horizon, pilot_key(key), score)?;
     let mut sums = s.baseline_sums();
     let mut sc = s.scratch();
     s.fit(0, pilot, &mut sums, &mut sc);
@@ -555,8 +586,8 @@ pub fn estimate_j_difference<E: Environment + ?Sized>(
     {
         return Err(McError::PolicyShape);
     }
-    let sb = Streamer::new(env, base, horizon, key)?;
-    let sc = Streamer::new(env, candidate, horizon, key)?;
+    let sb = Streamer::new(env, base, horizon, key, ScoreAction::Raw)?;
+    let sc = Streamer::new(env, candidate, horizon, key, ScoreAction::Raw)?;
     let (m, _) = stream(&sb, n, 1, |first, count, d, w| {
         w.tmp.resize(count, 0.0);
         let steps = sb.returns(first, &mut w.tmp, &mut w.sc) + sc.returns(first, d, &mut w.sc);

@@ -182,6 +182,11 @@ impl Environment for MountainCar {
     fn features(&self, state: &[f64], phi: &mut [f64]) {
         self.features.eval_unchecked(state, phi);
     }
+
+    /// The force `a` clipped to `[−1, 1]` (the reward still charges the raw action).
+    fn clip_action(&self, _: usize, a: f64) -> f64 {
+        a.clamp(-1.0, 1.0)
+    }
 }
 
 /// One transition from `(pos, vel)` under the raw action `a` (the rules in the module

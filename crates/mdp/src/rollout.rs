@@ -17,7 +17,9 @@
 //! cum_score_w[i, t]  = Σ_{k ≤ min(t, len_i − 1)} ((a_k − μ(s_k))/σ)² − 1
 //! G_i                = Σ_t γ^t r_t
 //! ```
-//! where `a_k − μ(s_k) = σ z_k` is the raw (unclipped) Gaussian perturbation.
+//! where `a_k − μ(s_k) = σ z_k` is the raw (unclipped) Gaussian perturbation. With
+//! [`ScoreAction::Clipped`] the scores take the action after clipping to the action box
+//! instead, `a_k − μ(s_k) = clip(a_k) − μ(s_k)` ([`Environment::clip_action`]).
 
 use rayon::prelude::*;
 
@@ -29,6 +31,34 @@ use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uni
 
 /// Number of trajectories in one parallel work item.
 pub const CHUNK: usize = 64;
+
+/// Which action the policy scores `∇_v log π(a|s)`, `∇_w log π(a|s)` of a scored rollout are
+/// evaluated at (Sec 2.3.1; the policy scores of Sec 4.3.4).
+///
+/// The environment always applies the clipped action; only the scores differ. `Raw` scores
+/// the sampled Gaussian action, which makes them the exact scores of the policy and the
+/// gradient estimators unbiased. `Clipped` scores `a_c = clip(a)` (the choice of the
+/// thesis-era code): the estimators are then biased wherever the action box clips, and the
+/// scores coincide with `Raw` (up to rounding) where it does not. `Raw` is the default.
+///
+/// # Formula
+/// ```text
+/// Raw:      ∇_v log π = (a − μ(s)) φ(s) / σ²,     ∇_w log π = ((a − μ(s))/σ)² − 1
+/// Clipped:  ∇_v log π = (a_c − μ(s)) φ(s) / σ²,   ∇_w log π = ((a_c − μ(s))/σ)² − 1
+/// ```
+///
+/// ```
+/// use sepg_mdp::rollout::ScoreAction;
+/// assert_eq!(ScoreAction::default(), ScoreAction::Raw);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum ScoreAction {
+    /// Scores of the raw sampled action `a = μ(s) + σ z` (exact policy scores).
+    #[default]
+    Raw,
+    /// Scores of the clipped action `clip(a)` that the environment applies.
+    Clipped,
+}
 
 /// Errors of the rollout engine.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -116,6 +146,39 @@ pub fn rollout_into<E: Environment + ?Sized>(
     key: SeedKey,
     batch: &mut Batch,
 ) -> Result<(), RolloutError> {
+    rollout_into_with(env, policy, n, horizon, key, ScoreAction::Raw, batch)
+}
+
+/// [`rollout_into`] with the scores evaluated at the action chosen by `score`
+/// ([`ScoreAction::Raw`] is exactly [`rollout_into`]). The trajectories (states, actions,
+/// rewards) do not depend on `score`.
+///
+/// # Formula
+/// ```text
+/// cum_score_v[i, t] = Σ_{k ≤ t} (â_k − μ(s_k)) φ(s_k) / σ²,   cum_score_w[i, t] = Σ_{k ≤ t} ((â_k − μ(s_k))/σ)² − 1
+/// â_k = a_k (Raw) or clip(a_k) (Clipped)
+/// ```
+///
+/// ```
+/// use sepg_mdp::{env::LqgEnv, policy::GaussianPolicy, rng::SeedKey, Batch};
+/// use sepg_mdp::rollout::{ScoreAction, rollout, rollout_into_with};
+/// let (env, key) = (LqgEnv::lqg1d(), SeedKey::new(1, 0, 0));
+/// let pi = GaussianPolicy::scalar(-0.1, 1.0).unwrap();
+/// let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
+/// rollout_into_with(&env, &pi, 10, 5, key, ScoreAction::Clipped, &mut b).unwrap();
+/// let raw = rollout(&env, &pi, 10, 5, key).unwrap();
+/// assert_eq!(b.disc_rewards, raw.disc_rewards);
+/// assert_ne!(b.cum_score_w, raw.cum_score_w);
+/// ```
+pub fn rollout_into_with<E: Environment + ?Sized>(
+    env: &E,
+    policy: &GaussianPolicy,
+    n: usize,
+    horizon: usize,
+    key: SeedKey,
+    score: ScoreAction,
+    batch: &mut Batch,
+) -> Result<(), RolloutError> {
     check(env, policy, n, horizon)?;
     let (sigma, inv_sigma) = policy.sigma_raw();
     if policy.is_deterministic() {
@@ -145,18 +208,19 @@ pub fn rollout_into<E: Environment + ?Sized>(
             v: policy.v()[0],
             sigma: sigma[0],
             inv_sigma: inv_sigma[0],
+            score,
         };
         fill_batch_scalar(batch, key, p, pol, limit)
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
-        let fused = FusedPolicy::of(env, policy);
+        let fused = FusedPolicy::of(env, policy, score);
         fill_batch(batch, key, dims, |rngs, rewards, score_v, score_w, sc| {
             let mut rows = TrajRows {
                 rewards,
                 score_v,
                 score_w,
             };
-            let (len, g) = kernel(env, policy, fused, gamma, limit, rngs, &mut rows, sc);
+            let (len, g) = kernel(env, policy, fused, score, gamma, limit, rngs, &mut rows, sc);
             (len, finite_trajectory(g, &sc.cum_v, &sc.cum_w))
         })
     };
@@ -230,6 +294,7 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
                 v,
                 sigma: 0.0,
                 inv_sigma: 0.0,
+                score: ScoreAction::Raw,
             };
             fill_returns_scalar::<false>(out, key, p, pol, limit);
         } else {
@@ -237,14 +302,27 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
                 v,
                 sigma: sigma[0],
                 inv_sigma: inv_sigma[0],
+                score: ScoreAction::Raw,
             };
             fill_returns_scalar::<true>(out, key, p, pol, limit);
         }
     } else {
         let dims = (env.state_dim(), env.action_dim(), env.feature_dim());
-        let fused = FusedPolicy::of(env, policy);
+        let fused = FusedPolicy::of(env, policy, ScoreAction::Raw);
         fill_returns(out, key, dims, |rngs, sc| {
-            kernel(env, policy, fused, gamma, limit, rngs, &mut NoSteps, sc).1
+            let raw = ScoreAction::Raw;
+            kernel(
+                env,
+                policy,
+                fused,
+                raw,
+                gamma,
+                limit,
+                rngs,
+                &mut NoSteps,
+                sc,
+            )
+            .1
         });
     }
     if out.iter().all(|x| x.is_finite()) {
@@ -536,12 +614,14 @@ where
 /// the CPU overlap their latencies. The arithmetic of each trajectory is unchanged.
 pub(crate) const LANES: usize = 4;
 
-/// Mean gain and noise scale of a one-feature, one-action policy.
+/// Mean gain and noise scale of a one-feature, one-action policy, and the action its scores
+/// are evaluated at.
 #[derive(Clone, Copy)]
 pub(crate) struct ScalarPolicy {
     pub(crate) v: f64,
     pub(crate) sigma: f64,
     pub(crate) inv_sigma: f64,
+    pub(crate) score: ScoreAction,
 }
 
 /// [`fill_batch`] for the scalar LQG, running the fused kernel on groups of [`LANES`]
@@ -684,18 +764,29 @@ pub(crate) fn scalar_kernel<const K: usize, S: LaneSink<K>, const STOCH: bool>(
     rngs: &mut [TrajectoryRngs; K],
     sink: &mut S,
 ) -> [f64; K] {
-    if p.clipping {
-        scalar_kernel_impl::<K, S, STOCH, true>(p, pol, limit, rngs, sink)
-    } else {
-        scalar_kernel_impl::<K, S, STOCH, false>(p, pol, limit, rngs, sink)
+    let clipped_scores = S::SCORES && STOCH && pol.score == ScoreAction::Clipped;
+    match (p.clipping, clipped_scores) {
+        (true, false) => scalar_kernel_impl::<K, S, STOCH, true, false>(p, pol, limit, rngs, sink),
+        (false, false) => {
+            scalar_kernel_impl::<K, S, STOCH, false, false>(p, pol, limit, rngs, sink)
+        }
+        (true, true) => scalar_kernel_impl::<K, S, STOCH, true, true>(p, pol, limit, rngs, sink),
+        (false, true) => scalar_kernel_impl::<K, S, STOCH, false, true>(p, pol, limit, rngs, sink),
     }
 }
 
-/// [`scalar_kernel`] with the clipping decided at compile time. Each step first draws the
-/// lanes' variates (policy stream, then environment stream, in the same per-stream order as
-/// the generic kernel), then runs the short branch-free arithmetic over the lanes.
+/// [`scalar_kernel`] with the clipping and the scored action (`CSCORE`: the clipped one)
+/// decided at compile time. Each step first draws the lanes' variates (policy stream, then
+/// environment stream, in the same per-stream order as the generic kernel), then runs the
+/// short branch-free arithmetic over the lanes.
 #[inline(always)]
-fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const CLIP: bool>(
+fn scalar_kernel_impl<
+    const K: usize,
+    S: LaneSink<K>,
+    const STOCH: bool,
+    const CLIP: bool,
+    const CSCORE: bool,
+>(
     p: &ScalarLqg,
     pol: ScalarPolicy,
     limit: usize,
@@ -707,6 +798,7 @@ fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const C
         v,
         sigma,
         inv_sigma,
+        ..
     } = pol;
     let noisy = p.noise_std > 0.0;
     let mut s: [f64; K] =
@@ -730,7 +822,7 @@ fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const C
             let mu = v * sk;
             let a = if STOCH {
                 let zk = z[k];
-                if S::SCORES {
+                if S::SCORES && !CSCORE {
                     cv[k] += zk * inv_sigma * sk;
                     cw[k] += zk * zk - 1.0;
                 }
@@ -743,6 +835,11 @@ fn scalar_kernel_impl<const K: usize, S: LaneSink<K>, const STOCH: bool, const C
             } else {
                 a
             };
+            if CSCORE {
+                let zc = (ac - mu) * inv_sigma;
+                cv[k] += zc * inv_sigma * sk;
+                cw[k] += zc * zc - 1.0;
+            }
             let r = -(sk * (p.q * sk) + ac * (p.r * ac));
             let dr = disc * r;
             sink.record(k, t, dr, cv[k], cw[k]);
@@ -770,11 +867,17 @@ pub(crate) struct FusedPolicy {
     sigma: f64,
     inv_sigma: f64,
     stochastic: bool,
+    clipped_scores: bool,
 }
 
 impl FusedPolicy {
-    /// The fused Mountain Car policy, if `env` and `policy` have that shape.
-    pub(crate) fn of<E: Environment + ?Sized>(env: &E, policy: &GaussianPolicy) -> Option<Self> {
+    /// The fused Mountain Car policy, if `env` and `policy` have that shape, scoring the action
+    /// chosen by `score`.
+    pub(crate) fn of<E: Environment + ?Sized>(
+        env: &E,
+        policy: &GaussianPolicy,
+        score: ScoreAction,
+    ) -> Option<Self> {
         let mc = env.as_mountain_car()?;
         let state_bias = matches!(mc.feature_map(), FeatureMap::StateBias { dim: 2 });
         let v: [f64; 3] = policy.v().try_into().ok()?;
@@ -788,19 +891,21 @@ impl FusedPolicy {
             sigma: if stochastic { sigma[0] } else { 0.0 },
             inv_sigma: if stochastic { inv_sigma[0] } else { 0.0 },
             stochastic,
+            clipped_scores: score == ScoreAction::Clipped,
         })
     }
 }
 
-/// One trajectory with the fused kernel when there is one (`fused`), else the generic kernel;
-/// both compute the same bits. Returns `(len, G)`; afterwards `sc.cum_v`, `sc.cum_w` hold the
-/// final cumulative scores.
+/// One trajectory with the fused kernel when there is one (`fused`, built with the same
+/// `score`), else the generic kernel; both compute the same bits. Returns `(len, G)`;
+/// afterwards `sc.cum_v`, `sc.cum_w` hold the final cumulative scores.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn kernel<E: Environment + ?Sized, S: TrajSink>(
     env: &E,
     policy: &GaussianPolicy,
     fused: Option<FusedPolicy>,
+    score: ScoreAction,
     gamma: f64,
     limit: usize,
     rngs: &mut TrajectoryRngs,
@@ -809,7 +914,7 @@ pub(crate) fn kernel<E: Environment + ?Sized, S: TrajSink>(
 ) -> (usize, f64) {
     match fused {
         Some(p) => mountain_car_kernel(p, gamma, limit, rngs, sink, sc),
-        None => generic_kernel(env, policy, gamma, limit, rngs, sink, sc),
+        None => generic_kernel(env, policy, score, gamma, limit, rngs, sink, sc),
     }
 }
 
@@ -835,14 +940,20 @@ fn mountain_car_kernel<S: TrajSink>(
         let mu = p.v[0] * phi[0] + p.v[1] * phi[1] + p.v[2] * phi[2];
         let a = if p.stochastic {
             let z = standard_normal(&mut rngs.policy);
+            let a = mu + p.sigma * z;
             if S::SCORES {
+                let z = if p.clipped_scores {
+                    (a.clamp(-1.0, 1.0) - mu) * p.inv_sigma
+                } else {
+                    z
+                };
                 let c = z * p.inv_sigma;
                 for (cvk, f) in cv.iter_mut().zip(phi) {
                     *cvk += c * f;
                 }
                 cw[0] += z * z - 1.0;
             }
-            mu + p.sigma * z
+            a
         } else {
             mu
         };
@@ -862,12 +973,13 @@ fn mountain_car_kernel<S: TrajSink>(
     (len, ret)
 }
 
-/// The generic kernel over any [`Environment`]. Returns `(len, G)`; stops after a terminal
-/// step.
+/// The generic kernel over any [`Environment`], scoring the action chosen by `score`. Returns
+/// `(len, G)`; stops after a terminal step.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn generic_kernel<E: Environment + ?Sized, S: TrajSink>(
     env: &E,
     policy: &GaussianPolicy,
+    score: ScoreAction,
     gamma: f64,
     limit: usize,
     rngs: &mut TrajectoryRngs,
@@ -876,6 +988,7 @@ pub(crate) fn generic_kernel<E: Environment + ?Sized, S: TrajSink>(
 ) -> (usize, f64) {
     let (sigma, inv_sigma) = policy.sigma_raw();
     let stochastic = !policy.is_deterministic();
+    let clipped_scores = score == ScoreAction::Clipped;
     let p = policy.feature_dim();
     let l = policy.action_dim();
     env.reset(&mut rngs.env, &mut sc.state);
@@ -888,14 +1001,20 @@ pub(crate) fn generic_kernel<E: Environment + ?Sized, S: TrajSink>(
             let mu = policy.mean_j(&sc.phi, j);
             sc.action[j] = if stochastic {
                 let z = standard_normal(&mut rngs.policy);
+                let a = mu + sigma[j] * z;
                 if S::SCORES {
+                    let z = if clipped_scores {
+                        (env.clip_action(j, a) - mu) * inv_sigma[j]
+                    } else {
+                        z
+                    };
                     let c = z * inv_sigma[j];
                     for (cv, f) in sc.cum_v[j * p..(j + 1) * p].iter_mut().zip(&sc.phi) {
                         *cv += c * f;
                     }
                     sc.cum_w[j] += z * z - 1.0;
                 }
-                mu + sigma[j] * z
+                a
             } else {
                 mu
             };
@@ -921,7 +1040,8 @@ mod tests {
     use nalgebra::DVector;
 
     /// The fused Mountain Car kernel and the generic kernel agree bit for bit: scored batches
-    /// (with terminations and padding) and returns of stochastic and deterministic policies.
+    /// (with terminations and padding, scores on raw and on clipped actions) and returns of
+    /// stochastic and deterministic policies.
     #[test]
     fn mountain_car_kernel_matches_generic_kernel() {
         let env = crate::mountain_car::MountainCar::state_bias();
@@ -938,33 +1058,36 @@ mod tests {
                 false,
             ),
         ] {
-            assert!(FusedPolicy::of(&env, &pi).is_some());
-            let fast = rollout(&env, &pi, n, h, key).unwrap();
-            assert_eq!(fast.steps() < n * h, terminates);
-            let mut slow = fast.clone();
-            fill_batch(
-                &mut slow,
-                key,
-                (2, 1, 3),
-                |rngs, rewards, score_v, score_w, sc| {
-                    let mut rows = TrajRows {
-                        rewards,
-                        score_v,
-                        score_w,
-                    };
-                    (
-                        generic_kernel(&env, &pi, 0.99, h, rngs, &mut rows, sc).0,
-                        true,
-                    )
-                },
-            );
-            assert_eq!(fast, slow);
+            for score in [ScoreAction::Raw, ScoreAction::Clipped] {
+                assert!(FusedPolicy::of(&env, &pi, score).is_some());
+                let mut fast = Batch::zeros(0, 0, 0, 0, 0.0);
+                rollout_into_with(&env, &pi, n, h, key, score, &mut fast).unwrap();
+                assert_eq!(fast.steps() < n * h, terminates);
+                let mut slow = fast.clone();
+                fill_batch(
+                    &mut slow,
+                    key,
+                    (2, 1, 3),
+                    |rngs, rewards, score_v, score_w, sc| {
+                        let mut rows = TrajRows {
+                            rewards,
+                            score_v,
+                            score_w,
+                        };
+                        let k = generic_kernel(&env, &pi, score, 0.99, h, rngs, &mut rows, sc);
+                        (k.0, true)
+                    },
+                );
+                assert_eq!(fast, slow);
+            }
             for p in [pi.clone(), pi.to_deterministic()] {
                 let fast = rollout_returns(&env, &p, n, h, key).unwrap();
                 let mut sc = Scratch::new((2, 1, 3));
                 for (i, g) in fast.iter().enumerate() {
                     let mut rngs = key.rngs(i as u64);
-                    let slow = generic_kernel(&env, &p, 0.99, h, &mut rngs, &mut NoSteps, &mut sc);
+                    let raw = ScoreAction::Raw;
+                    let slow =
+                        generic_kernel(&env, &p, raw, 0.99, h, &mut rngs, &mut NoSteps, &mut sc);
                     assert_eq!(g.to_bits(), slow.1.to_bits());
                 }
             }
@@ -972,7 +1095,7 @@ mod tests {
     }
 
     /// The fused scalar kernel and the generic kernel agree bit for bit on every scalar LQG
-    /// variant (clipping on/off, noise on/off).
+    /// variant (clipping on/off, noise on/off), with scores on raw and on clipped actions.
     #[test]
     fn scalar_kernel_matches_generic_kernel() {
         let base = LqgModel::lqg1d();
@@ -991,36 +1114,40 @@ mod tests {
         let (n, h) = (70, 15);
         for model in models {
             let env = LqgEnv::new(model).unwrap();
-            let fast = rollout(&env, &pi, n, h, key).unwrap();
-            let mut slow = fast.clone();
             let gamma = env.gamma();
-            fill_batch(
-                &mut slow,
-                key,
-                (1, 1, 1),
-                |rngs, rewards, score_v, score_w, sc| {
-                    let mut rows = TrajRows {
-                        rewards,
-                        score_v,
-                        score_w,
-                    };
-                    (
-                        generic_kernel(&env, &pi, gamma, h, rngs, &mut rows, sc).0,
-                        true,
-                    )
-                },
-            );
-            assert_eq!(fast, slow);
+            for score in [ScoreAction::Raw, ScoreAction::Clipped] {
+                let mut fast = Batch::zeros(0, 0, 0, 0, 0.0);
+                rollout_into_with(&env, &pi, n, h, key, score, &mut fast).unwrap();
+                let mut slow = fast.clone();
+                fill_batch(
+                    &mut slow,
+                    key,
+                    (1, 1, 1),
+                    |rngs, rewards, score_v, score_w, sc| {
+                        let mut rows = TrajRows {
+                            rewards,
+                            score_v,
+                            score_w,
+                        };
+                        let k = generic_kernel(&env, &pi, score, gamma, h, rngs, &mut rows, sc);
+                        (k.0, true)
+                    },
+                );
+                assert_eq!(fast, slow);
+            }
             let fast_g = rollout_returns(&env, &pi, n, h, key).unwrap();
             let det = pi.to_deterministic();
             let fast_det = rollout_returns(&env, &det, n, h, key).unwrap();
             for i in 0..n {
                 let mut sc = Scratch::new((1, 1, 1));
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel(&env, &pi, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
+                let raw = ScoreAction::Raw;
+                let g =
+                    generic_kernel(&env, &pi, raw, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_g[i].to_bits());
                 let mut rngs = key.rngs(i as u64);
-                let g = generic_kernel(&env, &det, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
+                let g =
+                    generic_kernel(&env, &det, raw, gamma, h, &mut rngs, &mut NoSteps, &mut sc).1;
                 assert_eq!(g.to_bits(), fast_det[i].to_bits());
             }
         }

@@ -18,8 +18,8 @@ use crate::env::{Environment, ScalarLqg};
 use crate::policy::GaussianPolicy;
 use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix};
 use crate::rollout::{
-    FusedPolicy, LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, Scratch, TrajSink, check,
-    kernel, scalar_kernel,
+    FusedPolicy, LANES, LaneSink, NoSteps, RolloutError, ScalarPolicy, ScoreAction, Scratch,
+    TrajSink, check, kernel, scalar_kernel,
 };
 
 /// A per-step baseline for each v- and w-component: `v[t·dim_v + k]`, `w[t·dim_w + j]`.
@@ -62,6 +62,7 @@ pub(crate) struct Streamer<'a, E: Environment + ?Sized> {
     policy: &'a GaussianPolicy,
     scalar: Option<(ScalarLqg, ScalarPolicy)>,
     fused: Option<FusedPolicy>,
+    score: ScoreAction,
     gamma: f64,
     limit: usize,
     horizon: usize,
@@ -69,12 +70,14 @@ pub(crate) struct Streamer<'a, E: Environment + ?Sized> {
 }
 
 impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
-    /// Checks the shapes (as [`crate::rollout::rollout`] does) and prepares the kernels.
+    /// Checks the shapes (as [`crate::rollout::rollout`] does) and prepares the kernels, whose
+    /// scores are evaluated at the action chosen by `score`.
     pub(crate) fn new(
         env: &'a E,
         policy: &'a GaussianPolicy,
         horizon: usize,
         key: SeedKey,
+        score: ScoreAction,
     ) -> Result<Self, RolloutError> {
         check(env, policy, 1, horizon)?;
         let (sigma, inv_sigma) = policy.sigma_raw();
@@ -84,12 +87,14 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                     v: policy.v()[0],
                     sigma: 0.0,
                     inv_sigma: 0.0,
+                    score,
                 }
             } else {
                 ScalarPolicy {
                     v: policy.v()[0],
                     sigma: sigma[0],
                     inv_sigma: inv_sigma[0],
+                    score,
                 }
             };
             (*p, pol)
@@ -98,7 +103,8 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
             env,
             policy,
             scalar,
-            fused: FusedPolicy::of(env, policy),
+            fused: FusedPolicy::of(env, policy, score),
+            score,
             gamma: env.gamma(),
             limit: env.time_limit().map_or(horizon, |tl| tl.min(horizon)),
             horizon,
@@ -163,6 +169,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                         self.env,
                         self.policy,
                         self.fused,
+                        self.score,
                         self.gamma,
                         self.limit,
                         &mut rngs,
@@ -262,6 +269,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                 self.env,
                 self.policy,
                 self.fused,
+                self.score,
                 self.gamma,
                 self.limit,
                 &mut rngs,
@@ -352,6 +360,7 @@ impl<'a, E: Environment + ?Sized> Streamer<'a, E> {
                 self.env,
                 self.policy,
                 self.fused,
+                self.score,
                 self.gamma,
                 self.limit,
                 &mut rngs,

@@ -541,6 +541,7 @@ impl RunSpec {
             seed: schedule.seed,
             initial_budget: start.budget0,
             options: options.unwrap_or_default(),
+            score_action: Default::default(),
         };
         let checked = config
             .check()

@@ -3,6 +3,7 @@
 use sepg_bounds::constants::TaskConstants;
 use sepg_estimators::GradientSpec;
 use sepg_mdp::env::{AnyEnv, Environment};
+use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
@@ -244,6 +245,10 @@ pub struct SepgConfig {
     /// requirement, alternating iterations, the reference batch of J(θ⁰), constant overrides
     /// (ignored by the comparison algorithms except the overrides).
     pub options: SepgOptions,
+    /// The action at which the sampled mode's rollouts evaluate the policy scores: the raw
+    /// Gaussian action (exact scores, unbiased estimators; the default) or the action clipped
+    /// to the action box (the thesis-era code). Ignored by exact gradients.
+    pub score_action: ScoreAction,
 }
 
 impl SepgConfig {
@@ -266,6 +271,7 @@ impl SepgConfig {
             seed: 0,
             initial_budget: 0.0,
             options: SepgOptions::default(),
+            score_action: ScoreAction::Raw,
         }
     }
 

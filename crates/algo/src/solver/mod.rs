@@ -76,15 +76,18 @@ impl PolicySolver {
         let cfg = config.config();
         let constants = *config.constants();
         let source: Box<dyn GradientSource> = match cfg.gradient {
-            GradientMode::Sampled { delta } => Box::new(SampledSource::new(
-                cfg.env.clone(),
-                cfg.horizon,
-                cfg.seed,
-                delta,
-                cfg.options.confidence.factor(),
-                cfg.estimator,
-                constants,
-            )),
+            GradientMode::Sampled { delta } => Box::new(
+                SampledSource::new(
+                    cfg.env.clone(),
+                    cfg.horizon,
+                    cfg.seed,
+                    delta,
+                    cfg.options.confidence.factor(),
+                    cfg.estimator,
+                    constants,
+                )
+                .with_score_action(cfg.score_action),
+            ),
             GradientMode::Exact => {
                 let unsupported = |e: sepg_mdp::oracle::OracleError| {
                     ConfigError::ExactUnsupported { env: e.to_string() }

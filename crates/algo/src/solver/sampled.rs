@@ -8,7 +8,7 @@ use sepg_mdp::Batch;
 use sepg_mdp::env::{AnyEnv, Environment};
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
-use sepg_mdp::rollout::{rollout_into, rollout_returns_into};
+use sepg_mdp::rollout::{ScoreAction, rollout_into_with, rollout_returns_into};
 
 use crate::core::error::RunError;
 use crate::core::seed::Block;
@@ -33,6 +33,7 @@ pub(crate) struct SampledSource {
     batch: Batch,
     returns: Vec<f64>,
     estimator: BlockEstimator,
+    score_action: ScoreAction,
 }
 
 /// The estimates of one block from its batch of trajectories: Ĵ, the requested gradients
@@ -158,7 +159,15 @@ impl SampledSource {
             returns: Vec::new(),
             estimator: BlockEstimator::new(delta, spec, constants)
                 .with_confidence_factor(confidence_factor),
+            score_action: ScoreAction::Raw,
         }
+    }
+
+    /// The same source with the scores of its rollouts evaluated at the action chosen by
+    /// `score` (raw by default).
+    pub(crate) fn with_score_action(mut self, score: ScoreAction) -> Self {
+        self.score_action = score;
+        self
     }
 }
 
@@ -327,7 +336,8 @@ impl GradientSource for SampledSource {
                 steps: (q.n * limit) as u64,
             });
         }
-        rollout_into(&self.env, &policy, q.n, self.horizon, key, &mut self.batch).map_err(me)?;
+        let (n, h, score) = (q.n, self.horizon, self.score_action);
+        rollout_into_with(&self.env, &policy, n, h, key, score, &mut self.batch).map_err(me)?;
         self.estimator.estimate(&self.batch, q.need)
     }
 }

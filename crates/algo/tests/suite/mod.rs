@@ -10,3 +10,4 @@ mod options;
 mod plumbing;
 mod safety;
 mod sampled;
+mod score_action;
