@@ -21,7 +21,7 @@ use sepg_algo::core::state::State;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::spec::{Resolved, RunSpec, VERSION};
+use crate::spec::{Resolved, RunSpec, ScoresName, VERSION};
 
 /// Resolved configuration of a run.
 pub const CONFIG_FILE: &str = "config.toml";
@@ -289,6 +289,10 @@ pub struct Summary {
     /// The task constants the bounds used, after the overrides.
     #[serde(default)]
     pub constants: UsedConstants,
+    /// The action the policy scores were evaluated at (sampled gradients only; absent from
+    /// older summaries, which always used the raw action).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<ScoresName>,
 }
 
 /// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).

@@ -13,7 +13,8 @@ use clap::ValueEnum;
 
 use crate::error::{Error, Result};
 use crate::spec::{
-    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, WDirectionName, WStepName,
+    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, ScoresName, WDirectionName,
+    WStepName,
 };
 use crate::sweep::{self, Seeds, Shard, SweepFile, SweepOptions, SweepSpec, SweepStats};
 
@@ -137,6 +138,7 @@ impl Setting {
                 baseline_fit: Some(FitName::PlugIn),
                 reference_batch: Some(0),
                 psi: Some(POTION_PSI),
+                scores: Some(ScoresName::Clipped),
                 ..OptionFlags::default()
             },
             Setting::NoConfidence => OptionFlags {
@@ -196,6 +198,9 @@ pub struct OptionFlags {
     /// ψ used by the bound of Theorem 4.3 [default: 0.523557].
     #[cfg_attr(feature = "clap", arg(long))]
     pub psi: Option<f64>,
+    /// Policy scores at the raw or at the clipped action [default: raw].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub scores: Option<ScoresName>,
 }
 
 impl OptionFlags {
@@ -218,7 +223,8 @@ impl OptionFlags {
             r_max,
             m_phi,
             action_volume,
-            psi
+            psi,
+            scores
         )
     }
 
@@ -245,6 +251,7 @@ impl OptionFlags {
             m_phi: self.m_phi,
             action_volume: self.action_volume,
             psi: self.psi,
+            scores: self.scores,
             ..RunSpec::default()
         }
     }
@@ -498,6 +505,7 @@ mod tests {
         assert_eq!(adam.w_direction, None);
         assert_eq!(adam.baseline_fit, Some(FitName::PlugIn));
         assert_eq!((lb1.psi, adam.psi), (Some(0.53), Some(0.53)));
+        assert_eq!(adam.scores, Some(ScoresName::Clipped));
         let (_, resolved) = crate::sweep::expand(&spec, crate::sweep::Shard { index: 0, count: 1 })
             .expect("every run resolves");
         assert_eq!(resolved.len(), 880);

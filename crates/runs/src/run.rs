@@ -284,6 +284,7 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
                 psi: k.psi_used(),
             }
         },
+        scores: resolved.spec.scores,
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     Ok(summary)
