@@ -91,9 +91,10 @@ pub enum Setting {
     Default,
     /// The thesis-era public code's choices that reproduce the published SEPG cells: no
     /// confidence widths (its δ = 1), no reference batch (J(θ⁰) from the first batch),
-    /// ψ = 0.53 in d, and the w-direction ∇̂_w L assembled from full-batch (plug-in)
-    /// products, the quantity the thesis's text follows; ν-split LB-I, one v-block and one
-    /// w-block per iteration. No guarantee holds under it.
+    /// ψ = 0.53 in d, policy scores at the clipped action, and the w-direction ∇̂_w L
+    /// assembled from full-batch (plug-in) products, the quantity the thesis's text follows;
+    /// ν-split LB-I, one v-block and one w-block per iteration, leave-one-out baselines. No
+    /// guarantee holds under it.
     ThesisCode,
     /// The thesis-era public code taken literally (potion `algorithms/safe.py`, January
     /// 2019): no confidence widths, the metagradient w-direction, LB-I's full requirement per
@@ -128,6 +129,7 @@ impl Setting {
                 w_direction: Some(WDirectionName::PlugIn),
                 reference_batch: Some(0),
                 psi: Some(POTION_PSI),
+                scores: Some(ScoresName::Clipped),
                 ..OptionFlags::default()
             },
             Setting::PotionLiteral => OptionFlags {
@@ -514,8 +516,9 @@ mod tests {
         assert!(default.variant.iter().all(|v| v.psi.is_none()));
     }
 
-    /// The thesis-code setting fixes no confidence, no reference batch, ψ = 0.53 and the
-    /// plug-in w-direction for every SEPG variant, and nothing that applies to MI/LB-I only.
+    /// The thesis-code setting fixes no confidence, no reference batch, ψ = 0.53, clipped
+    /// scores and the plug-in w-direction for every SEPG variant, and nothing that applies to
+    /// MI/LB-I only.
     #[test]
     fn thesis_code_setting_fixes_its_options() {
         let opts = ReproduceOptions {
@@ -532,6 +535,7 @@ mod tests {
             assert_eq!(v.confidence, Some(ConfidenceName::None));
             assert_eq!(v.w_direction, Some(WDirectionName::PlugIn));
             assert_eq!((v.reference_batch, v.psi), (Some(0), Some(0.53)));
+            assert_eq!(v.scores, Some(ScoresName::Clipped));
             assert_eq!((v.alternating, v.lb1_requirement), (None, None));
         }
     }
