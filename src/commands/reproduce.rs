@@ -43,7 +43,8 @@ pub struct ReproduceArgs {
     )]
     fig_sigma0: f64,
     /// Named choice of the algorithm options: sepg's guaranteed defaults, the thesis-era
-    /// public code's choices, or the defaults without confidence widths.
+    /// choices that reproduce the published SEPG cells, the thesis-era code taken literally,
+    /// or the defaults without confidence widths (docs/REPRODUCTION.md lists each).
     #[arg(long, value_enum, default_value_t = Setting::Default)]
     setting: Setting,
     /// Options overriding the setting's.

@@ -75,6 +75,11 @@ pub fn psi() -> Interval {
     Interval::from_sorted(PSI_LO, PSI_HI)
 }
 
+/// ψ of the task, enclosed: [`psi`], or the override of `TaskConstants::with_psi` exactly.
+fn psi_of(k: &TaskConstants) -> Interval {
+    k.psi_override().map_or_else(psi, Interval::point)
+}
+
 /// 1 − γ, enclosed.
 fn one_minus_gamma(k: &TaskConstants) -> Interval {
     Interval::point(1.0) - Interval::point(k.gamma())
@@ -127,7 +132,8 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     positive("sigma", sigma)?;
     let om = one_minus_gamma(k);
     let front = Interval::point(k.r_max()) / om.sqr();
-    let bracket = psi() * Interval::point(k.action_volume()) / Interval::point(sigma).scale(2.0)
+    let bracket = psi_of(k) * Interval::point(k.action_volume())
+        / Interval::point(sigma).scale(2.0)
         + Interval::point(k.gamma()) / om;
     Ok(front * bracket)
 }
@@ -466,7 +472,7 @@ impl RigorousEnclosure {
         positive("sigma", sigma)?;
         let om = one_minus_gamma(k);
         let r = Interval::point(k.r_max());
-        let a = r * psi() * Interval::point(k.action_volume())
+        let a = r * psi_of(k) * Interval::point(k.action_volume())
             / (om.sqr() * Interval::point(sigma).scale(2.0));
         let g = Interval::point(k.gamma()) * r / (om.sqr() * om).scale(2.0);
         // K_W of `rigorous::k_w` is computed to within a few ulps (tested against a 60-digit

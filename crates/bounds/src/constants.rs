@@ -20,6 +20,7 @@ pub struct TaskConstants {
     r_max: f64,
     m_phi: f64,
     action_volume: f64,
+    psi: Option<f64>,
 }
 
 impl TaskConstants {
@@ -53,7 +54,47 @@ impl TaskConstants {
             r_max: positive("r_max", r_max)?,
             m_phi: positive("m_phi", m_phi)?,
             action_volume: positive("action_volume", action_volume)?,
+            psi: None,
         })
+    }
+
+    /// The same constants with ψ of Lemma A.1 replaced by `psi` in d (Theorem 4.3) and every
+    /// bound built on it (the thesis-era public code used ψ = 0.53). The bounds stay valid for
+    /// any `psi` ≥ [`psi()`]; a smaller value voids them.
+    ///
+    /// Errors: `psi` not finite and strictly positive.
+    ///
+    /// ```
+    /// use sepg_bounds::constants::{TaskConstants, d, psi};
+    /// let k = TaskConstants::new(0.0, 1.0, 1.0, 2.0)?;
+    /// assert_eq!(d(&k.with_psi(0.53)?, 1.0)?, 0.53);
+    /// assert_eq!(k.psi_override(), None);
+    /// assert!(k.with_psi(f64::NAN).is_err());
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn with_psi(self, psi: f64) -> Result<Self, BoundsError> {
+        Ok(Self {
+            psi: Some(positive("psi", psi)?),
+            ..self
+        })
+    }
+
+    /// The ψ that replaces Lemma A.1's value, if any ([`TaskConstants::with_psi`]).
+    pub fn psi_override(&self) -> Option<f64> {
+        self.psi
+    }
+
+    /// The ψ that d (Theorem 4.3) uses: the override, or Lemma A.1's [`psi()`].
+    ///
+    /// ```
+    /// use sepg_bounds::constants::{TaskConstants, psi};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// assert_eq!(k.psi_used(), psi());
+    /// assert_eq!(k.with_psi(0.53)?.psi_used(), 0.53);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn psi_used(&self) -> f64 {
+        self.psi.unwrap_or_else(psi)
     }
 
     /// The discount factor γ ∈ [0, 1).
@@ -183,12 +224,17 @@ pub fn dc_dsigma(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     no_overflow("dc/dsigma", front * bracket)
 }
 
+/// ψ of the task: Lemma A.1's value unless [`TaskConstants::with_psi`] replaced it.
+fn psi_of(k: &TaskConstants) -> f64 {
+    k.psi_used()
+}
+
 /// The penalty coefficient `d` of the variance-parameter bound (Theorem 4.3, eq. (4.15)).
 ///
 /// # Formula
 ///
 /// ```text
-/// d(σ) = R / (1 − γ)² · ( ψ |A| / (2σ) + γ / (1 − γ) ),   ψ = psi()
+/// d(σ) = R / (1 − γ)² · ( ψ |A| / (2σ) + γ / (1 − γ) ),   ψ = psi() unless overridden
 /// ```
 ///
 /// Domain: σ > 0 is the standard deviation *before* the w-update (σ = e^w). Units of R per
@@ -204,7 +250,7 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     positive("sigma", sigma)?;
     let one_minus = 1.0 - k.gamma;
     let front = k.r_max / (one_minus * one_minus);
-    let bracket = psi() * k.action_volume / (2.0 * sigma) + k.gamma / one_minus;
+    let bracket = psi_of(k) * k.action_volume / (2.0 * sigma) + k.gamma / one_minus;
     no_overflow("d", front * bracket)
 }
 
@@ -214,7 +260,7 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 pub(crate) fn d_parts(k: &TaskConstants, sigma: f64) -> Result<(f64, f64), BoundsError> {
     positive("sigma", sigma)?;
     let one_minus = 1.0 - k.gamma;
-    let a = k.r_max * psi() * k.action_volume / (2.0 * one_minus * one_minus * sigma);
+    let a = k.r_max * psi_of(k) * k.action_volume / (2.0 * one_minus * one_minus * sigma);
     let g = k.gamma * k.r_max / (2.0 * one_minus * one_minus * one_minus);
     Ok((no_overflow("d", a)?, no_overflow("d", g)?))
 }

@@ -21,7 +21,7 @@ use sepg_algo::core::state::State;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::spec::{Resolved, RunSpec, VERSION};
+use crate::spec::{Resolved, RunSpec, ScoresName, VERSION};
 
 /// Resolved configuration of a run.
 pub const CONFIG_FILE: &str = "config.toml";
@@ -289,9 +289,13 @@ pub struct Summary {
     /// The task constants the bounds used, after the overrides.
     #[serde(default)]
     pub constants: UsedConstants,
+    /// The action the policy scores were evaluated at (sampled gradients only; absent from
+    /// older summaries, which always used the raw action).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<ScoresName>,
 }
 
-/// The task constants γ, R, M_φ, |A| a run's bounds used (after the overrides).
+/// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct UsedConstants {
     /// Discount factor γ.
@@ -302,6 +306,10 @@ pub struct UsedConstants {
     pub m_phi: f64,
     /// Action-space volume |A|.
     pub action_volume: f64,
+    /// ψ of Lemma A.1 in d (Theorem 4.3): 0.523557 unless overridden (absent from the
+    /// summaries of older versions, which always used that value).
+    #[serde(default = "sepg_bounds::constants::psi")]
+    pub psi: f64,
 }
 
 /// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.

@@ -13,7 +13,8 @@ use clap::ValueEnum;
 
 use crate::error::{Error, Result};
 use crate::spec::{
-    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, WDirectionName, WStepName,
+    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, ScoresName, WDirectionName,
+    WStepName,
 };
 use crate::sweep::{self, Seeds, Shard, SweepFile, SweepOptions, SweepSpec, SweepStats};
 
@@ -79,7 +80,8 @@ pub enum LqgPreset {
     Lqg1d,
 }
 
-/// A named choice of the algorithm options for a whole reproduction.
+/// A named choice of the algorithm options for a whole reproduction. The options each
+/// setting fixes are listed in docs/REPRODUCTION.md; flags override them one by one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
 pub enum Setting {
@@ -87,15 +89,25 @@ pub enum Setting {
     /// J(θ⁰), cross-fitted ∇̂_w L, ν-split LB-I, leave-one-out baselines.
     #[default]
     Default,
-    /// The choices of the thesis-era public code (potion, `algorithms/safe.py`, January
-    /// 2019): no confidence widths (δ = 1), the metagradient w-direction, LB-I's full
-    /// requirement per half-step, alternating v/w iterations for MI and LB-I, plug-in
-    /// baselines, no reference batch. No guarantee holds under it.
+    /// The thesis-era public code's choices that reproduce the published SEPG cells: no
+    /// confidence widths (its δ = 1), no reference batch (J(θ⁰) from the first batch),
+    /// ψ = 0.53 in d, policy scores at the clipped action, and the w-direction ∇̂_w L
+    /// assembled from full-batch (plug-in) products, the quantity the thesis's text follows;
+    /// ν-split LB-I, one v-block and one w-block per iteration, leave-one-out baselines. No
+    /// guarantee holds under it.
     ThesisCode,
+    /// The thesis-era public code taken literally (potion `algorithms/safe.py`, January
+    /// 2019): no confidence widths, the metagradient w-direction, LB-I's full requirement per
+    /// half-step, alternating v/w iterations for MI and LB-I, plug-in baselines, ψ = 0.53, no
+    /// reference batch. No guarantee holds under it.
+    PotionLiteral,
     /// The thesis's algorithm as described, with estimates used as exact: the defaults
     /// without confidence widths and without the reference batch. No guarantee holds under it.
     NoConfidence,
 }
+
+/// ψ of the thesis-era public code's d (Theorem 4.3), rounded up from 0.523557.
+const POTION_PSI: f64 = 0.53;
 
 impl Setting {
     /// The setting's name on the command line and in reports.
@@ -103,6 +115,7 @@ impl Setting {
         match self {
             Setting::Default => "default",
             Setting::ThesisCode => "thesis-code",
+            Setting::PotionLiteral => "potion-literal",
             Setting::NoConfidence => "no-confidence",
         }
     }
@@ -113,11 +126,21 @@ impl Setting {
             Setting::Default => OptionFlags::default(),
             Setting::ThesisCode => OptionFlags {
                 confidence: Some(ConfidenceName::None),
+                w_direction: Some(WDirectionName::PlugIn),
+                reference_batch: Some(0),
+                psi: Some(POTION_PSI),
+                scores: Some(ScoresName::Clipped),
+                ..OptionFlags::default()
+            },
+            Setting::PotionLiteral => OptionFlags {
+                confidence: Some(ConfidenceName::None),
                 w_direction: Some(WDirectionName::Metagradient),
                 lb1_requirement: Some(Lb1Name::Full),
                 alternating: Some(true),
                 baseline_fit: Some(FitName::PlugIn),
                 reference_batch: Some(0),
+                psi: Some(POTION_PSI),
+                scores: Some(ScoresName::Clipped),
                 ..OptionFlags::default()
             },
             Setting::NoConfidence => OptionFlags {
@@ -174,6 +197,12 @@ pub struct OptionFlags {
     /// |A| used by the bounds [default: the environment's].
     #[cfg_attr(feature = "clap", arg(long = "action-volume"))]
     pub action_volume: Option<f64>,
+    /// ψ used by the bound of Theorem 4.3 [default: 0.523557].
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub psi: Option<f64>,
+    /// Policy scores at the raw or at the clipped action [default: raw].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub scores: Option<ScoresName>,
 }
 
 impl OptionFlags {
@@ -195,7 +224,9 @@ impl OptionFlags {
             gamma,
             r_max,
             m_phi,
-            action_volume
+            action_volume,
+            psi,
+            scores
         )
     }
 
@@ -221,6 +252,8 @@ impl OptionFlags {
             r_max: self.r_max,
             m_phi: self.m_phi,
             action_volume: self.action_volume,
+            psi: self.psi,
+            scores: self.scores,
             ..RunSpec::default()
         }
     }
@@ -445,13 +478,13 @@ pub fn run(
 mod tests {
     use super::*;
 
-    /// The thesis-code setting reaches the SEPG variants (alternating and LB-I's full
-    /// requirement only where they apply), the baseline fit reaches every variant, and a flag
-    /// overrides the setting.
+    /// The potion-literal setting reaches the SEPG variants (alternating and LB-I's full
+    /// requirement only where they apply), the baseline fit and ψ reach every variant, and a
+    /// flag overrides the setting.
     #[test]
     fn settings_reach_the_variants_they_apply_to() {
         let opts = ReproduceOptions {
-            setting: Setting::ThesisCode,
+            setting: Setting::PotionLiteral,
             flags: OptionFlags {
                 confidence: Some(ConfidenceName::StudentT),
                 ..OptionFlags::default()
@@ -473,10 +506,37 @@ mod tests {
         assert_eq!(zv.confidence, Some(ConfidenceName::StudentT));
         assert_eq!(adam.w_direction, None);
         assert_eq!(adam.baseline_fit, Some(FitName::PlugIn));
+        assert_eq!((lb1.psi, adam.psi), (Some(0.53), Some(0.53)));
+        assert_eq!(adam.scores, Some(ScoresName::Clipped));
         let (_, resolved) = crate::sweep::expand(&spec, crate::sweep::Shard { index: 0, count: 1 })
             .expect("every run resolves");
         assert_eq!(resolved.len(), 880);
         let default = sweep_spec(&ReproduceOptions::new(Experiment::Table51)).expect("valid");
         assert!(default.variant.iter().all(|v| v.w_direction.is_none()));
+        assert!(default.variant.iter().all(|v| v.psi.is_none()));
+    }
+
+    /// The thesis-code setting fixes no confidence, no reference batch, ψ = 0.53, clipped
+    /// scores and the plug-in w-direction for every SEPG variant, and nothing that applies to
+    /// MI/LB-I only.
+    #[test]
+    fn thesis_code_setting_fixes_its_options() {
+        let opts = ReproduceOptions {
+            setting: Setting::ThesisCode,
+            ..ReproduceOptions::new(Experiment::Table51)
+        };
+        let spec = sweep_spec(&opts).expect("valid");
+        for v in spec.variant.iter().filter(|v| {
+            matches!(
+                v.algo,
+                Some(AlgoName::SepgMi | AlgoName::SepgLb1 | AlgoName::SepgZv)
+            )
+        }) {
+            assert_eq!(v.confidence, Some(ConfidenceName::None));
+            assert_eq!(v.w_direction, Some(WDirectionName::PlugIn));
+            assert_eq!((v.reference_batch, v.psi), (Some(0), Some(0.53)));
+            assert_eq!(v.scores, Some(ScoresName::Clipped));
+            assert_eq!((v.alternating, v.lb1_requirement), (None, None));
+        }
     }
 }

@@ -281,8 +281,10 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
                 r_max: k.r_max(),
                 m_phi: k.m_phi(),
                 action_volume: k.action_volume(),
+                psi: k.psi_used(),
             }
         },
+        scores: resolved.spec.scores,
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     Ok(summary)

@@ -17,6 +17,7 @@ use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
 use sepg_mdp::mountain_car::MountainCar;
 use sepg_mdp::oracle::ClosedFormOracle;
+use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::error::{Error, Result};
@@ -235,6 +236,29 @@ pub enum ConfidenceName {
     StudentT,
     /// No widths: estimates used as exact (the thesis-era code's δ = 1).
     None,
+}
+
+/// The action the policy scores of the sampled gradients are evaluated at, accepted by
+/// `--scores`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ScoresName {
+    /// The sampled action a = μ(s) + σz: the exact scores ∇ log π(a|s), unbiased estimators.
+    Raw,
+    /// The action the environment applies, clip(a) (the thesis-era code's choice): the
+    /// estimators are biased wherever the action box clips.
+    Clipped,
+}
+
+impl ScoresName {
+    /// The rollout engine's choice for this name.
+    pub fn score_action(self) -> ScoreAction {
+        match self {
+            ScoresName::Raw => ScoreAction::Raw,
+            ScoresName::Clipped => ScoreAction::Clipped,
+        }
+    }
 }
 
 /// LB-I's requirement per half-step, accepted by `--lb1-requirement`.
@@ -465,6 +489,16 @@ pub struct RunSpec {
     )]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub action_volume: Option<f64>,
+    /// ψ of Lemma A.1 used by the bound of Theorem 4.3 [default: 0.523557; the thesis-era
+    /// code used 0.53]; the bounds hold for ψ ≥ 0.523557.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub psi: Option<f64>,
+    /// Policy scores of the sampled gradients at the raw or at the clipped action
+    /// [default: raw].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scores: Option<ScoresName>,
 }
 
 macro_rules! overlay_fields {
@@ -481,7 +515,7 @@ impl RunSpec {
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
             estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
             metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
-            reference_batch, gamma, r_max, m_phi, action_volume)
+            reference_batch, gamma, r_max, m_phi, action_volume, psi, scores)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -536,7 +570,9 @@ impl RunSpec {
             seed: schedule.seed,
             initial_budget: start.budget0,
             options: options.unwrap_or_default(),
-            score_action: Default::default(),
+            score_action: self
+                .scores
+                .map_or(ScoreAction::Raw, ScoresName::score_action),
         };
         let checked = config
             .check()
@@ -552,6 +588,8 @@ impl RunSpec {
                     .clone()
                     .unwrap_or_else(|| VERSION.to_owned()),
             ),
+            scores: (gradients == GradientsName::Sampled)
+                .then_some(self.scores.unwrap_or(ScoresName::Raw)),
             ..RunSpec::resolved_values(&method, &sampling, start, &schedule, options.as_ref())
         };
         Ok(Resolved {
@@ -634,6 +672,11 @@ impl RunSpec {
         )?;
         reject(exact && self.delta.is_some(), "delta", "to exact gradients")?;
         reject(
+            exact && self.scores.is_some(),
+            "scores",
+            "to exact gradients",
+        )?;
+        reject(
             exact
                 && (self.estimator.is_some()
                     || self.baseline.is_some()
@@ -698,6 +741,7 @@ impl RunSpec {
             r_max: self.r_max,
             m_phi: self.m_phi,
             action_volume: self.action_volume,
+            psi: self.psi,
         };
         let defaults = SepgOptions::default();
         if !algo.is_sepg() {
@@ -856,6 +900,7 @@ impl RunSpec {
             r_max: o.overrides.r_max,
             m_phi: o.overrides.m_phi,
             action_volume: o.overrides.action_volume,
+            psi: o.overrides.psi,
             ..RunSpec::default()
         };
         let (sepg, naive, lb1) = match method.algorithm {
@@ -1126,9 +1171,12 @@ mod tests {
             reference_batch: Some(0),
             gamma: Some(0.9),
             r_max: Some(30.0),
+            psi: Some(0.53),
+            scores: Some(ScoresName::Clipped),
             ..RunSpec::default()
         };
         let once = spec.resolve().expect("valid");
+        assert_eq!(once.checked.config().score_action, ScoreAction::Clipped);
         let o = once.checked.config().options;
         assert_eq!(o.w_step, WStep::Theorem49);
         assert_eq!(o.w_direction, WDirection::Metagradient { clip: 50.0 });
@@ -1138,11 +1186,14 @@ mod tests {
         assert_eq!(o.reference_batch, 0);
         assert_eq!(once.checked.constants().gamma(), 0.9);
         assert_eq!(once.checked.constants().r_max(), 30.0);
+        assert_eq!(once.checked.constants().psi_override(), Some(0.53));
         assert_eq!(once.spec.m_phi, None);
         let text = once.toml().expect("toml");
         assert!(
             text.contains("w-step = \"theorem-4.9\"") && text.contains("quantile-factor = 2.0")
         );
+        assert!(text.contains("psi = 0.53"), "{text}");
+        assert!(text.contains("scores = \"clipped\""), "{text}");
         let again: RunSpec = toml::from_str(&text).expect("parse");
         let twice = again.resolve().expect("valid");
         assert_eq!(once.spec, twice.spec);
@@ -1158,6 +1209,9 @@ mod tests {
         assert_eq!(plain.spec.confidence, Some(ConfidenceName::StudentT));
         assert_eq!(plain.spec.reference_batch, Some(1000));
         assert_eq!(plain.spec.lb1_requirement, None);
+        assert_eq!(plain.checked.constants().psi_override(), None);
+        assert_eq!(plain.spec.scores, Some(ScoresName::Raw));
+        assert_eq!(plain.checked.config().score_action, ScoreAction::Raw);
     }
 
     #[test]
@@ -1193,6 +1247,11 @@ mod tests {
             RunSpec {
                 gradients: Some(GradientsName::Exact),
                 reference_batch: Some(10),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                gradients: Some(GradientsName::Exact),
+                scores: Some(ScoresName::Clipped),
                 ..RunSpec::default()
             },
             RunSpec {

@@ -388,6 +388,10 @@ impl SepgConfig {
             o.m_phi.unwrap_or(k.m_phi),
             o.action_volume.unwrap_or(k.action_volume),
         )
+        .and_then(|c| match o.psi {
+            Some(psi) => c.with_psi(psi),
+            None => Ok(c),
+        })
         .map_err(|e| ConfigError::Environment(e.to_string()))?;
         Ok(CheckedConfig {
             inner: self,

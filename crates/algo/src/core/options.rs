@@ -10,7 +10,7 @@
 //! | [`SepgOptions::lb1_requirement`] | [`Lb1Requirement::Split`] | [`Lb1Requirement::Full`] |
 //! | [`SepgOptions::alternating`] | `false` | `true` |
 //! | [`SepgOptions::reference_batch`] | 1000 | 0 |
-//! | [`SepgOptions::overrides`] | none | γ = 0.9 in its script |
+//! | [`SepgOptions::overrides`] | none | γ = 0.9 in its script, ψ = 0.53 in d |
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
@@ -93,7 +93,7 @@ pub enum Lb1Requirement {
     Full,
 }
 
-/// Overrides of the task constants R, M_φ, |A| and γ that the bounds use.
+/// Overrides of the task constants R, M_φ, |A|, γ and ψ that the bounds use.
 ///
 /// `gamma` also changes the environment's discount, so J itself changes; the others only
 /// change the bounds (they must stay valid bounds for the guarantees to hold).
@@ -107,6 +107,9 @@ pub struct ConstantOverrides {
     pub m_phi: Option<f64>,
     /// Action-space volume |A|.
     pub action_volume: Option<f64>,
+    /// ψ of Lemma A.1 in d (Theorem 4.3); the thesis-era code used 0.53. The bounds hold for
+    /// any value ≥ 0.523557 (`sepg_bounds::constants::psi`).
+    pub psi: Option<f64>,
 }
 
 /// SEPG options (see the module documentation for the defaults and the thesis-era values).

@@ -231,26 +231,17 @@ impl Solver for PolicySolver {
     fn next_iter(&mut self, state: &mut State) -> Result<Record, RunError> {
         self.init(state)?;
         match self.algorithm {
-            Algorithm::Sepg(req) => sepg::iterate(
-                &mut *self.source,
-                &self.constants,
-                req,
-                false,
-                self.n,
-                &self.options,
-                state,
-                self.certified,
-            ),
-            Algorithm::SepgNaiveW(req) => sepg::iterate(
-                &mut *self.source,
-                &self.constants,
-                req,
-                true,
-                self.n,
-                &self.options,
-                state,
-                self.certified,
-            ),
+            Algorithm::Sepg(req) | Algorithm::SepgNaiveW(req) => {
+                let setup = sepg::Setup {
+                    k: &self.constants,
+                    req,
+                    naive_w: matches!(self.algorithm, Algorithm::SepgNaiveW(_)),
+                    n: self.n,
+                    opts: &self.options,
+                    certify: self.certified,
+                };
+                sepg::iterate(&mut *self.source, &setup, state)
+            }
             other => baseline::iterate(&mut *self.source, &self.constants, other, self.n, state),
         }
     }

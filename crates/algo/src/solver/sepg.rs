@@ -58,6 +58,104 @@ fn min_sigma(w: &[f64]) -> f64 {
     w.iter().fold(f64::INFINITY, |m, &wi| m.min(wi.exp()))
 }
 
+/// The fixed inputs of every SEPG iteration of a run.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Setup<'a> {
+    /// Task constants of the bounds.
+    pub(crate) k: &'a TaskConstants,
+    /// The safety requirement.
+    pub(crate) req: Requirement,
+    /// The w-update along ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20).
+    pub(crate) naive_w: bool,
+    /// Trajectories per iteration.
+    pub(crate) n: usize,
+    /// The remaining choices ([`SepgOptions`]).
+    pub(crate) opts: &'a SepgOptions,
+    /// Certified steps (`sepg_bounds::certified`).
+    pub(crate) certify: bool,
+}
+
+/// The v-update of a block whose estimate `e` holds ∇_v J, from (`v`, `w`) for `required`:
+/// its plan, the new v and its step size α (0 when it makes no update).
+fn v_update(
+    setup: &Setup,
+    v: &[f64],
+    w: &[f64],
+    e: &Estimate,
+    required: f64,
+) -> Result<(Plan, Vec<f64>, f64), RunError> {
+    let grad_v = e.grad_v.as_ref().ok_or(RunError::Estimator(
+        "the v-block returned no gradient".into(),
+    ))?;
+    let plan = steps::v_step(setup.k, min_sigma(w), grad_v, required, setup.certify)?;
+    let mut v_new = v.to_vec();
+    apply(&mut v_new, &plan);
+    let alpha = match plan {
+        Plan::Update(s) => s.size,
+        Plan::BelowNoise => 0.0,
+    };
+    Ok((plan, v_new, alpha))
+}
+
+/// `Err` unless every new parameter is finite.
+fn check_finite(v_new: &[f64], w_new: &[f64], iteration: u64) -> Result<(), RunError> {
+    if v_new.iter().chain(w_new).any(|x| !x.is_finite()) {
+        return Err(RunError::NonFinite {
+            what: "policy parameters",
+            iteration,
+        });
+    }
+    Ok(())
+}
+
+/// The fields of a [`Record`] that do not come from the update blocks' logs.
+struct Row {
+    iteration: u64,
+    v: Vec<f64>,
+    w: Vec<f64>,
+    sigma: Vec<f64>,
+    j_exploratory: f64,
+    j_after_v: Option<f64>,
+    j_target: f64,
+    w_target: Option<Vec<f64>>,
+    budget: f64,
+    required_v: Option<f64>,
+    required_w: Option<f64>,
+    trajectories: u64,
+    steps: u64,
+}
+
+/// The record of an iteration from its row and the logs of its v- and w-blocks.
+fn record(row: Row, v_log: BlockLog, w_log: BlockLog) -> Record {
+    Record {
+        iteration: row.iteration,
+        v: row.v,
+        w: row.w,
+        sigma: row.sigma,
+        j_exploratory: row.j_exploratory,
+        j_after_v: row.j_after_v,
+        j_target: row.j_target,
+        w_target: row.w_target,
+        budget: row.budget,
+        required_v: row.required_v,
+        required_w: row.required_w,
+        alpha: v_log.size,
+        beta: w_log.size,
+        lambda_v: v_log.lambda,
+        lambda_w: w_log.lambda,
+        guaranteed_v: v_log.guaranteed,
+        guaranteed_w: w_log.guaranteed,
+        infeasible_v: v_log.infeasible,
+        infeasible_w: w_log.infeasible,
+        below_noise_v: v_log.below_noise,
+        below_noise_w: w_log.below_noise,
+        trajectories: row.trajectories,
+        steps: row.steps,
+        certified_v: v_log.certified,
+        certified_w: w_log.certified,
+    }
+}
+
 /// Before the first iteration of LB-I and the type-II requirements, estimates J(θ⁰) from a
 /// reference batch of `opts.reference_batch` trajectories and stores its upper confidence
 /// bound Û⁰ = Ĵ⁰ + ε₀ as LB-I's J(θ⁰) and as the reference of the budget's first exploratory
@@ -102,23 +200,23 @@ fn reference(
     Ok(())
 }
 
-/// Runs SEPG iteration `state.iteration` for `req`; `naive_w` selects the w-update along
-/// ∇_w J (eq. 4.12) instead of ∇_w L (eq. 4.20); `certify` selects certified steps
-/// (`sepg_bounds::certified`); `opts` the remaining choices ([`SepgOptions`]).
-#[allow(clippy::too_many_arguments)]
+/// Runs SEPG iteration `state.iteration` with the fixed inputs `setup`.
 pub(crate) fn iterate(
     source: &mut dyn GradientSource,
-    k: &TaskConstants,
-    req: Requirement,
-    naive_w: bool,
-    n: usize,
-    opts: &SepgOptions,
+    setup: &Setup,
     state: &mut State,
-    certify: bool,
 ) -> Result<Record, RunError> {
+    let Setup {
+        k,
+        req,
+        naive_w,
+        n,
+        opts,
+        certify,
+    } = *setup;
     reference(source, req, opts, state)?;
     if opts.alternating {
-        return iterate_alternating(source, k, req, naive_w, n, opts, state, certify);
+        return iterate_alternating(source, setup, state);
     }
     let t = state.iteration;
     let sizes = split(n, req.blocks());
@@ -172,7 +270,6 @@ pub(crate) fn iterate(
     }
 
     let sigmas = state.sigma();
-    let sigma = min_sigma(&state.w);
     // Type-I requirement Cᵗ (Table 4.1) split (1 − ν)C / νC (eqs. 4.13, 4.14); SIM-ν splits
     // the budget νB / (1 − ν)B (Sec 5.1.3); other type-II updates use C = −B.
     // With `Lb1Requirement::Full` the v-update gets all of Cᵗ and the w-update its own
@@ -192,17 +289,8 @@ pub(crate) fn iterate(
         (None, Some(nu)) => -nu * budget.value(),
         (None, None) => budget.required_improvement(),
     };
-    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
-        "the v-block returned no gradient".into(),
-    ))?;
-    let v_plan = steps::v_step(k, sigma, grad_v, required_v, certify)?;
+    let (v_plan, v_new, alpha) = v_update(setup, &state.v, &state.w, &ev, required_v)?;
     let v_log = BlockLog::from_plan(&v_plan);
-    let alpha = match v_plan {
-        Plan::Update(s) => s.size,
-        Plan::BelowNoise => 0.0,
-    };
-    let mut v_new = state.v.clone();
-    apply(&mut v_new, &v_plan);
 
     // Target block (LV, ZV, SIM-ν): evaluate θ_Tᵗ = (vᵗ, w_T) and update the budget (line 12).
     let mut w_target = Some(state.w.clone());
@@ -245,7 +333,7 @@ pub(crate) fn iterate(
     let mut w_new = state.w.clone();
     let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
         let required_w = -(1.0 - nu) * budget.value();
-        let plan = w_plan(k, &sigmas, &ev, required_w, naive_w, certify, opts, alpha)?;
+        let plan = w_plan(setup, &sigmas, &ev, required_w, alpha)?;
         apply(&mut w_new, &plan);
         (None, required_w, BlockLog::from_plan(&plan), j_t)
     } else {
@@ -265,19 +353,13 @@ pub(crate) fn iterate(
             (Requirement::LbI { .. }, true) => j_base - ew.j,
             _ => type_one.map_or(budget.required_improvement(), |(_, cw)| cw),
         };
-        let plan = w_plan(k, &sigmas, &ew, required_w, naive_w, certify, opts, alpha)?;
+        let plan = w_plan(setup, &sigmas, &ew, required_w, alpha)?;
         apply(&mut w_new, &plan);
         (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
     };
 
-    if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
-        return Err(RunError::NonFinite {
-            what: "policy parameters",
-            iteration: t,
-        });
-    }
-
-    let record = Record {
+    check_finite(&v_new, &w_new, t)?;
+    let row = Row {
         iteration: t,
         v: state.v.clone(),
         w: state.w.clone(),
@@ -289,21 +371,10 @@ pub(crate) fn iterate(
         budget: budget.value(),
         required_v: Some(required_v),
         required_w: Some(required_w),
-        alpha: v_log.size,
-        beta: w_log.size,
-        lambda_v: v_log.lambda,
-        lambda_w: w_log.lambda,
-        guaranteed_v: v_log.guaranteed,
-        guaranteed_w: w_log.guaranteed,
-        infeasible_v: v_log.infeasible,
-        infeasible_w: w_log.infeasible,
-        below_noise_v: v_log.below_noise,
-        below_noise_w: w_log.below_noise,
         trajectories,
         steps: env_steps,
-        certified_v: v_log.certified,
-        certified_w: w_log.certified,
     };
+    let record = record(row, v_log, w_log);
     state.iteration += 1;
     state.v = v_new;
     state.w = w_new;
@@ -327,17 +398,18 @@ pub(crate) fn iterate(
 /// the requirement measured at its own start (LB-I: J(θ⁰) − Ĵ, times 1 − ν or ν unless
 /// `Lb1Requirement::Full`). Each half-step keeps J ≥ J(θ⁰) on its own, since
 /// J_after ≥ J_before + ν(J(θ⁰) − J_before) ≥ J(θ⁰) whenever J_before ≥ J(θ⁰).
-#[allow(clippy::too_many_arguments)]
 fn iterate_alternating(
     source: &mut dyn GradientSource,
-    k: &TaskConstants,
-    req: Requirement,
-    naive_w: bool,
-    n: usize,
-    opts: &SepgOptions,
+    setup: &Setup,
     state: &mut State,
-    certify: bool,
 ) -> Result<Record, RunError> {
+    let Setup {
+        req,
+        naive_w,
+        n,
+        opts,
+        ..
+    } = *setup;
     let t = state.iteration;
     let v_turn = t.is_multiple_of(2);
     let e = source.estimate(&Query {
@@ -369,34 +441,23 @@ fn iterate_alternating(
     let sigmas = state.sigma();
     let (mut v_new, mut w_new) = (state.v.clone(), state.w.clone());
     let plan = if v_turn {
-        let g = e.grad_v.as_ref().ok_or(RunError::Estimator(
-            "the v-block returned no gradient".into(),
-        ))?;
-        let plan = steps::v_step(k, min_sigma(&state.w), g, required, certify)?;
-        apply(&mut v_new, &plan);
-        state.last_alpha = Some(match plan {
-            Plan::Update(s) => s.size,
-            Plan::BelowNoise => 0.0,
-        });
+        let (plan, v, alpha) = v_update(setup, &state.v, &state.w, &e, required)?;
+        v_new = v;
+        state.last_alpha = Some(alpha);
         plan
     } else {
         let alpha = state.last_alpha.unwrap_or(0.0);
-        let plan = w_plan(k, &sigmas, &e, required, naive_w, certify, opts, alpha)?;
+        let plan = w_plan(setup, &sigmas, &e, required, alpha)?;
         apply(&mut w_new, &plan);
         plan
     };
-    if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
-        return Err(RunError::NonFinite {
-            what: "policy parameters",
-            iteration: t,
-        });
-    }
+    check_finite(&v_new, &w_new, t)?;
     let log = BlockLog::from_plan(&plan);
     let idle = BlockLog::default();
     let (v_log, w_log) = if v_turn { (log, idle) } else { (idle, log) };
     state.trajectories += e.trajectories;
     state.steps += e.steps;
-    let record = Record {
+    let row = Row {
         iteration: t,
         v: state.v.clone(),
         w: state.w.clone(),
@@ -408,41 +469,33 @@ fn iterate_alternating(
         budget: state.budget,
         required_v: v_turn.then_some(required),
         required_w: (!v_turn).then_some(required),
-        alpha: v_log.size,
-        beta: w_log.size,
-        lambda_v: v_log.lambda,
-        lambda_w: w_log.lambda,
-        guaranteed_v: v_log.guaranteed,
-        guaranteed_w: w_log.guaranteed,
-        infeasible_v: v_log.infeasible,
-        infeasible_w: w_log.infeasible,
-        below_noise_v: v_log.below_noise,
-        below_noise_w: w_log.below_noise,
-        certified_v: v_log.certified,
-        certified_w: w_log.certified,
         trajectories: state.trajectories,
         steps: state.steps,
     };
+    let record = record(row, v_log, w_log);
     state.iteration += 1;
     state.v = v_new;
     state.w = w_new;
     Ok(record)
 }
 
-/// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `naive`), along the
-/// direction and in the form `opts` selects; `alpha` is the latest v-step size (for the
-/// metagradient direction).
-#[allow(clippy::too_many_arguments)]
+/// The w-update of a block whose estimate holds ∇_w J (and ∇_w L unless `setup.naive_w`),
+/// along the direction and in the form `setup.opts` selects; `alpha` is the latest v-step size
+/// (for the metagradient direction).
 fn w_plan(
-    k: &TaskConstants,
+    setup: &Setup,
     sigmas: &[f64],
     e: &Estimate,
     required: f64,
-    naive: bool,
-    certify: bool,
-    opts: &SepgOptions,
     alpha: f64,
 ) -> Result<Plan, RunError> {
+    let Setup {
+        k,
+        naive_w: naive,
+        certify,
+        opts,
+        ..
+    } = *setup;
     let missing = || RunError::Estimator("the w-block returned no w-gradient".into());
     let gj = e.grad_wj.as_ref().ok_or_else(missing)?;
     if naive {

@@ -205,6 +205,7 @@ fn overrides_reach_the_bounds_and_the_environment() {
                 r_max: Some(10.0),
                 m_phi: None,
                 action_volume: Some(3.0),
+                psi: Some(0.53),
             },
             ..SepgOptions::default()
         },
@@ -216,6 +217,10 @@ fn overrides_reach_the_bounds_and_the_environment() {
         (k.gamma(), k.r_max(), k.m_phi(), k.action_volume()),
         (0.9, 10.0, 4.0, 3.0)
     );
+    // d = R/(1 − γ)² (ψ|A|/(2σ) + γ/(1 − γ)) with ψ = 0.53, computed by hand at σ = 1.
+    let d = sepg_bounds::constants::d(k, 1.0).expect("d");
+    let expected = 10.0 / 0.01 * (0.53 * 3.0 / 2.0 + 9.0);
+    assert!((d - expected).abs() <= 1e-9 * expected, "{d} vs {expected}");
     assert_eq!(checked.config().env.constants().gamma, 0.9);
 }
 
