@@ -213,7 +213,7 @@ pub struct CheckMeta {
     pub id: String,
     /// The statement checked (name and number in the thesis).
     pub statement: String,
-    /// Where it is printed (section, equation, thesis line).
+    /// Where it is printed (section, equation).
     pub location: String,
     /// The claim, in words, with the exact form tested.
     pub claim: String,

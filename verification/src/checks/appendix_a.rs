@@ -315,7 +315,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut psi = meta(
         "lemma-a.1-psi-constant",
         "Lemma A.1 (the constant ψ)",
-        "Appendix A, Lemma A.1 and Theorem 4.3, thesis line 1578",
+        "Appendix A, Lemma A.1 and Theorem 4.3",
         "ψ = 4(√7−2)e^{√7/2−2}/√(2π) equals max_{χ≥0} |(χ²−4χ+1)e^{−χ/2}| / √(2π) (≈ 0.524).",
         "grid search over χ ∈ [0, 80] (step 1e-3) refined by 200 golden-section steps",
         "deterministic: one maximisation",
@@ -332,7 +332,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut formula = meta(
         "lemma-a.1-second-derivative-formula",
         "Lemma A.1, eq. (A.3) (second derivative in w)",
-        "Appendix A, eqs. (A.2)–(A.3), thesis line 1590",
+        "Appendix A, eqs. (A.2)–(A.3)",
         "∂²π/∂w² = (χ² − 4χ + 1) π with χ = ((a−μ)/σ)² (both sides scaled by σ).",
         "central second differences in w with steps 2e-3 and 1e-3 combined by Richardson \
          extrapolation (truncation error O(h⁴) ≲ 1e-9)",
@@ -351,7 +351,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut bound = meta(
         "lemma-a.1-second-derivative-bound",
         "Lemma A.1 (bound on ∂²π/∂w²)",
-        "Appendix A, Lemma A.1, thesis line 1578",
+        "Appendix A, Lemma A.1",
         "|∂²π_θ(a|s)/∂w²| ≤ ψ/σ_w for every action and every w.",
         "closed form (A.3), itself checked by lemma-a.1-second-derivative-formula",
         SAMPLING_ZW,
@@ -361,7 +361,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut a2 = meta(
         "lemma-a.2-printed",
         "Lemma A.2 (first-order lower bound in Δw), as printed",
-        "Appendix A, Lemma A.2, thesis line 1616",
+        "Appendix A, Lemma A.2",
         "π_{v,w+Δw}(a|s) − π_{v,w}(a|s) ≥ ∂_wπ Δw − ψΔw²/(2σ_w) for every Δw.",
         "exact densities",
         SAMPLING_ZWD,
@@ -376,7 +376,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut a2r = meta(
         "lemma-a.2-rigorous",
         "Lemma A.2 with the remainder bounded at min(σ, σ')",
-        "Appendix A, Lemma A.2 (corrected), thesis line 1616",
+        "Appendix A, Lemma A.2 (corrected)",
         "π_{v,w+Δw}(a|s) − π_{v,w}(a|s) ≥ ∂_wπ Δw − ψΔw²/(2 min(σ_w, σ_{w+Δw})).",
         "exact densities",
         SAMPLING_ZWD,
@@ -387,7 +387,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut l1f = meta(
         "lemma-a.3-l1-closed-form",
         "Lemma A.3 ground truth (L1 distance of same-mean Gaussians)",
-        "Appendix A, Lemma A.3, thesis line 1636",
+        "Appendix A, Lemma A.3",
         "‖N(μ, σ²) − N(μ, σ'²)‖₁ = 2[erf(x*/(σ₁√2)) − erf(x*/(σ₂√2))], σ₁ < σ₂, \
          x*² = 2σ₁²σ₂² ln(σ₂/σ₁)/(σ₂² − σ₁²).",
         "composite Simpson integration of |p − p'| on [0, x*], [x*, x* + 40σ₁], \
@@ -407,7 +407,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut a3 = meta(
         "lemma-a.3-l1-squared",
         "Lemma A.3 (squared policy distance)",
-        "Appendix A, Lemma A.3, thesis line 1636",
+        "Appendix A, Lemma A.3",
         "‖π_{v,w+Δw} − π_{v,w}‖²_∞ ≤ 2Δw² (‖·‖_∞ = sup over states of the L1 distance; σ is \
          state-independent) — tested without neglecting any o(Δw³) term.",
         "closed-form L1 distance (lemma-a.3-l1-closed-form)",
@@ -421,7 +421,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut chain = meta(
         "lemma-a.3-printed-kl-chain",
         "Lemma A.3 proof step (A.6)–(A.8)",
-        "Appendix A, eqs. (A.6)–(A.8), thesis line 1640",
+        "Appendix A, eqs. (A.6)–(A.8)",
         "2KL(π_{w+Δw} ‖ π_w) = e^{2Δw} − 1 − 2Δw ≤ 2Δw² (the printed chain, with the remainder \
          dropped).",
         "exact expression of the KL divergence (expm1)",

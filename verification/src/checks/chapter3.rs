@@ -431,7 +431,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.1-cpi-bound",
                     "Theorem 3.1 (Kakade & Langford CPI bound)",
-                    "Section 3.2, eqs. (3.2)–(3.4), thesis line 483",
+                    "Section 3.2, eqs. (3.2)–(3.4)",
                     "For π' = (1−α)π + απ̄ with π̄ greedy w.r.t. Q^π and every α ∈ [0,1]: \
                      J(π') − J(π) ≥ α/(1−γ)·(𝔸 − 2αγε/(1−γ(1−α))), 𝔸 = Σ_s d^π(s) Σ_a π̄(a|s) A^π(s,a) \
                      with the normalised d, ε = max_s |Σ_a π̄(a|s) A^π(s,a)| (printed form).",
@@ -449,7 +449,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.2-cpi-step",
                     "Theorem 3.2 (CPI step α* and guarantee)",
-                    "Section 3.2, eqs. (3.5)–(3.6), thesis line 497",
+                    "Section 3.2, eqs. (3.5)–(3.6)",
                     "With R = max|R(s,a)|, rewards in [−R, R] and α = min(α*, 1), \
                      α* = (1−γ)𝔸/(4R): J(π') − J(π) ≥ 𝔸²/(8R) (printed form).",
                     GT_EXACT,
@@ -469,7 +469,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.2-cpi-step-nonneg-rewards",
                     "Theorem 3.2 (CPI step α* and guarantee), rewards in [0, R]",
-                    "Section 3.2, eqs. (3.5)–(3.6), thesis line 497",
+                    "Section 3.2, eqs. (3.5)–(3.6)",
                     "Same as thm-3.2-cpi-step with rewards in [0, R] (Kakade & Langford's \
                      convention): J(π') − J(π) ≥ 𝔸²/(8R) at α = min((1−γ)𝔸/(4R), 1).",
                     GT_EXACT,
@@ -486,7 +486,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.3-performance-difference",
                     "Theorem 3.3 (performance difference lemma)",
-                    "Section 3.2, eq. (3.7), thesis line 523",
+                    "Section 3.2, eq. (3.7)",
                     "For any π, π̃: J(π̃) − J(π) = 1/(1−γ) Σ_s d^{π̃}(s) Σ_a π̃(a|s) A^π(s,a) \
                      (equality, normalised d).",
                     GT_EXACT,
@@ -502,7 +502,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.4-state-distribution",
                     "Theorem 3.4 (future-state distribution bound)",
-                    "Section 3.3, eqs. (3.8)–(3.9), thesis line 535",
+                    "Section 3.3, eqs. (3.8)–(3.9)",
                     "‖d^{π'} − d^π‖₁ ≤ γ/(1−γ)² · D_∞^{π,π'}, D_∞ = max_s ‖π'(·|s) − π(·|s)‖₁ \
                      (printed form, normalised d).",
                     GT_EXACT,
@@ -536,7 +536,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.5-pirotta-advantage-bound",
                     "Theorem 3.5 (Pirotta et al., bound with a baseline policy)",
-                    "Section 3.3, eqs. (3.10)–(3.11), thesis line 547",
+                    "Section 3.3, eqs. (3.10)–(3.11)",
                     "For any π, π', π_b: J(π') − J(π) ≥ Σ_s d^{π_b}(s) A^{π'}_π(s)/(1−γ) − \
                      γ/(1−γ)² · D_∞^{π_b,π'} · ΔA^{π'}_π / 2, ΔA = max_s A^{π'}_π(s) − min_s A^{π'}_π(s).",
                     GT_EXACT,
@@ -553,7 +553,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.6-q-bound-sup-q",
                     "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup Q as printed",
-                    "Section 3.3, eq. (3.12), thesis line 559",
+                    "Section 3.3, eq. (3.12)",
                     "J(π') − J(π) ≥ 𝔸^{π'}_{π,μ}/(1−γ) − γ/(1−γ)² · (D_∞^{π,π'})² · ‖Q^π‖_∞/2 \
                      with ‖Q^π‖_∞ read as sup_{s,a} Q^π(s,a) (no absolute value), signed rewards.",
                     GT_EXACT,
@@ -570,7 +570,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.6-q-bound-abs-q",
                     "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup |Q|",
-                    "Section 3.3, eq. (3.12), thesis line 559",
+                    "Section 3.3, eq. (3.12)",
                     "Same bound with ‖Q^π‖_∞ = sup_{s,a} |Q^π(s,a)|, signed rewards.",
                     GT_EXACT,
                 ),
@@ -587,7 +587,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.6-q-bound-nonneg-rewards",
                     "Theorem 3.6 (Pirotta et al., Q-based bound), rewards in [0, 1]",
-                    "Section 3.3, eq. (3.12), thesis line 559",
+                    "Section 3.3, eq. (3.12)",
                     "Same bound with rewards in [0, 1], where sup Q = sup |Q| (the setting of \
                      Pirotta et al.).",
                     GT_EXACT,
@@ -603,7 +603,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.7-uspi",
                     "Theorem 3.7 (USPI step size and guarantee)",
-                    "Section 3.3, Theorem 3.7 and eq. (3.13), thesis line 565",
+                    "Section 3.3, Theorem 3.7 and eq. (3.13)",
                     "π' = (1−α)π + απ̄, α = min(α*, 1), α* = (1−γ)𝔸/(γ D_∞^{π,π̄} ΔA^{π̄}_π): \
                      if α* ≤ 1, J(π') − J(π) ≥ 𝔸²/(2γ D_∞ ΔA); otherwise the bound (3.13) with \
                      π' = π̄ (𝔸, D_∞, ΔA all taken w.r.t. the greedy π̄).",
@@ -623,7 +623,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.8-q-bound-sup-q-costs",
                     "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup Q",
-                    "Section 3.4, Theorem 3.8, thesis line 595",
+                    "Section 3.4, Theorem 3.8",
                     "For a small step π' = (1−0.1α)π + 0.1απ₂ and rewards in [−1, 0] (costs, as in \
                      the LQG): J(π') − J(π) ≥ 1/(1−γ) Σ_s d^π(s) A^{π'}_π(s) − γ/(2(1−γ)²) \
                      ‖π' − π‖²_∞ ‖Q^π‖_∞, ‖Q‖_∞ = sup Q as printed.",
@@ -641,7 +641,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.8-q-bound-abs-q",
                     "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup |Q|",
-                    "Section 3.4, Theorem 3.8, thesis line 595",
+                    "Section 3.4, Theorem 3.8",
                     "Small steps π' = (1−0.1α)π + 0.1απ₂, signed rewards, ‖Q‖_∞ = sup |Q|.",
                     GT_EXACT,
                 ),
@@ -656,7 +656,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "lemma-3.15-trajectory-form",
                     "Lemma 3.15 (performance of π̃ through the advantage of π)",
-                    "Section 3.6, Lemma 3.15, thesis line 672",
+                    "Section 3.6, Lemma 3.15",
                     "J(π̃) = J(π) + E_{τ∼π̃}[Σ_t γ^t A_π(s_t, a_t)] = J(π) + 1/(1−γ) Σ_s d^{π̃}(s) \
                      Σ_a π̃(a|s) A_π(s,a) (both equalities).",
                     "exact evaluation; the trajectory form by propagating the state \
@@ -673,7 +673,7 @@ pub(crate) fn checks() -> Vec<Check> {
                 meta(
                     "thm-3.16-trpo-bound",
                     "Theorem 3.16 (TRPO lower bound)",
-                    "Section 3.6, Theorem 3.16, thesis line 700",
+                    "Section 3.6, Theorem 3.16",
                     "J(π̃) ≥ L_π(π̃) − C·max_s KL(π(·|s) ‖ π̃(·|s)), C = 4εγ/(1−γ)², \
                      ε = max_{s,a} |A_π(s,a)|, L_π(π̃) = J(π) + 1/(1−γ) Σ_s d^π(s) Σ_a π̃(a|s) A_π(s,a); \
                      π̃ = (1−α)π + απ₂ (cases with infinite KL are skipped).",

@@ -920,7 +920,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut c44 = meta(
         "cor-4.4-surrogate",
         "Corollary 4.4 (surrogate L as guaranteed improvement)",
-        "Section 4.3.3, thesis line 1015",
+        "Section 4.3.3",
         "The v-update with α* = 1/(2c) improves J by at least L = ‖∇_vJ‖₂²/(4mc).",
     );
     c44.basis = BASIS_C.into();
@@ -965,7 +965,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut e420 = meta(
         "eq-4.20-combined-update",
         "Update (4.20) with the split (4.13)–(4.14)",
-        "Section 4.3.3, thesis line 1053",
+        "Section 4.3.3",
         "v-step ᾱ = (1 + λ_v)α* for (1 − ν)C, then w-step β̄ along ∇_wL(v^{t+1}, w) for νC, for \
          C = κ·min(C_max^v, C_max^w): each half meets its share and J(θ^{t+1}) − J(θ^t) ≥ C.",
     );

@@ -1119,7 +1119,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut c313g = meta(
         "cor-3.13-gpomdp-batch-size",
         "Corollary 3.13, G(PO)MDP/PGT batch size",
-        "Section 3.4.1, thesis line 680",
+        "Section 3.4.1",
         "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
         "exact ∇_vJ of the clipped preset (DP oracle)",
     );
@@ -1128,7 +1128,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut c313r = meta(
         "cor-3.13-reinforce-batch-size",
         "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
-        "Section 3.4.1, thesis line 674; Pirotta et al. 2013, Theorem 5.4",
+        "Section 3.4.1; Pirotta et al. 2013, Theorem 5.4",
         "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
         "exact ∇_vJ of the clipped preset (DP oracle)",
     );
@@ -1137,7 +1137,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut c313p = meta(
         "cor-3.13-reinforce-printed",
         "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
-        "Section 3.4.1, thesis line 674",
+        "Section 3.4.1",
         "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
         "exact ∇_vJ of the clipped preset (DP oracle)",
     );
@@ -1184,7 +1184,7 @@ pub(crate) fn checks() -> Vec<Check> {
     let mut b1 = meta(
         "thm-b.1-h-unbiased",
         "Theorem B.1: ĥ of (B.3) is unbiased for h(θ)",
-        "Appendix B.1, thesis line 1756",
+        "Appendix B.1",
         "E[ĥ] = h(θ) = ∂_σ∇_vJ + (2/σ)∇_vJ (no baseline).",
         "exact ∇_vJ and ∂_σ∇_vJ: DP oracle (clipped) and closed form (unclipped)",
     );
@@ -1198,7 +1198,7 @@ pub(crate) fn checks() -> Vec<Check> {
         "app-b.2-baseline",
         "Appendix B.2: the baseline b_t = b̃_t(G_t + H_t)/(G_tH_t) keeps ĥ unbiased and reduces \
          its variance",
-        "Appendix B.2, thesis line 1814",
+        "Appendix B.2",
         "E[ĥ_B.2] = h(θ) (leave-one-out fit of the optimal b̃_t), and the per-trajectory \
          variance with the baseline is below the variance without.",
         "exact h(θ) as in thm-b.1-h-unbiased; pooled sample variances",
