@@ -1,6 +1,7 @@
-//! The configuration's `score_action` reaches the sampled rollouts: a run with scores on
-//! clipped actions gives, record for record, the run of a collector that hands in
-//! clipped-action rollouts, and differs from the default (raw-action scores) run.
+//! The configuration's `score_action` reaches the sampled rollouts of every algorithm (the
+//! SEPG variants and the comparison algorithms): a run with scores on clipped actions gives,
+//! record for record, the run of a collector that hands in clipped-action rollouts, and
+//! differs from the default (raw-action scores) run.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
@@ -69,6 +70,12 @@ fn clipped_action_scores_reach_the_sampled_rollouts() {
     for algorithm in [
         Algorithm::Sepg(Requirement::Zv),
         Algorithm::Sepg(Requirement::Mi),
+        Algorithm::GpomdpConst {
+            alpha: 1e-6,
+            beta: 1e-6,
+        },
+        Algorithm::adam(1e-4, 1e-4),
+        Algorithm::AdaStep,
     ] {
         let cfg = SepgConfig {
             sigma0: vec![3.0],
