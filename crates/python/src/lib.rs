@@ -19,6 +19,7 @@ use sepg_bounds::constants::TaskConstants;
 
 pub mod bounds;
 pub mod envs;
+pub mod pyjson;
 pub mod runs;
 pub mod safe;
 pub mod train;

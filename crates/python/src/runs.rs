@@ -1,7 +1,8 @@
 //! Run folders, sweeps, merges and audits of built-in environments through `sepg_runs`, the
 //! library behind `sepg run`, `sepg sweep`, `sepg merge` and `sepg audit`: the same folders,
-//! byte for byte. Options are passed as JSON text with the keys of the command line
-//! (`sepg.run` builds it from keyword arguments). The GIL is released while runs execute, and
+//! byte for byte. The options of a run are a dict with the keys of the command line
+//! (`sepg.run` builds it from keyword arguments), a sweep is JSON text with the keys of a
+//! sweep file, and summaries and reports are returned as dicts. The GIL is released while runs execute, and
 //! Ctrl-C stops a run at its next iteration after checkpointing (the folder can be resumed).
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -9,13 +10,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
-use pyo3::types::PyModule;
+use pyo3::types::{PyDict, PyModule};
 use sepg_runs::Error;
 use sepg_runs::folder::{self, Log, RUN_FILES};
 use sepg_runs::run::{self, Observer, RunOptions};
 use sepg_runs::spec::RunSpec;
 use sepg_runs::sweep::{self, Shard, SweepOptions, SweepSpec};
 
+use crate::pyjson::{from_py, serialize_to_py};
 use crate::{failed, invalid};
 
 /// Raises the stop flag of a run when Python has a pending signal (Ctrl-C), keeping the
@@ -75,10 +77,6 @@ impl Observer for SignalWatch {
     }
 }
 
-fn json<T: serde::Serialize>(value: &T) -> PyResult<String> {
-    serde_json::to_string(value).map_err(failed)
-}
-
 fn checkpoint_period(k: u64) -> PyResult<u64> {
     if k == 0 {
         Err(invalid("checkpoint_every must be at least 1"))
@@ -88,20 +86,21 @@ fn checkpoint_period(k: u64) -> PyResult<u64> {
 }
 
 /// Starts a run of a built-in environment into the folder `out` (absent or empty unless
-/// `force`) and runs it to completion; returns `summary.json` as text. `options` is a JSON
-/// object with the keys of `sepg run` (`env`, `algo`, `iterations`, `batch`, `seed`, ...),
+/// `force`) and runs it to completion; returns `summary.json` as a dict. `options` is a
+/// dict with the keys of `sepg run` (`env`, `algo`, `iterations`, `batch`, `seed`, ...),
 /// overriding those of the TOML file `config` when given.
 #[pyfunction]
 #[pyo3(signature = (out, options, config = None, force = false, checkpoint_every = 500))]
-fn run_folder(
-    py: Python<'_>,
+fn run_folder<'py>(
+    py: Python<'py>,
     out: PathBuf,
-    options: &str,
+    options: &Bound<'py, PyDict>,
     config: Option<PathBuf>,
     force: bool,
     checkpoint_every: u64,
-) -> PyResult<String> {
-    let top: RunSpec = serde_json::from_str(options).map_err(|e| invalid(format!("{e}")))?;
+) -> PyResult<Bound<'py, PyAny>> {
+    let top: RunSpec = serde_json::from_value(from_py(options, "options")?)
+        .map_err(|e| invalid(format!("{e}")))?;
     let base = match &config {
         Some(path) => RunSpec::from_file(path).map_err(invalid)?,
         None => RunSpec::default(),
@@ -125,14 +124,18 @@ fn run_folder(
             },
         )
     });
-    json(&summary.map_err(|e| watch.error(e))?)
+    serialize_to_py(py, &summary.map_err(|e| watch.error(e))?)
 }
 
 /// Resumes the run in `dir` from its checkpoint (a complete run is returned as is); returns
-/// `summary.json` as text.
+/// `summary.json` as a dict.
 #[pyfunction]
 #[pyo3(signature = (dir, checkpoint_every = 500))]
-fn resume_folder(py: Python<'_>, dir: PathBuf, checkpoint_every: u64) -> PyResult<String> {
+fn resume_folder(
+    py: Python<'_>,
+    dir: PathBuf,
+    checkpoint_every: u64,
+) -> PyResult<Bound<'_, PyAny>> {
     let watch = SignalWatch::new();
     let every = checkpoint_period(checkpoint_every)?;
     let summary = py.detach(|| {
@@ -145,18 +148,24 @@ fn resume_folder(py: Python<'_>, dir: PathBuf, checkpoint_every: u64) -> PyResul
             },
         )
     });
-    json(&summary.map_err(|e| watch.error(e))?)
+    serialize_to_py(py, &summary.map_err(|e| watch.error(e))?)
 }
 
 /// The contents of a run folder: `(config, columns, rows, summary)` with the configuration
-/// and the summary as JSON text (`None` for an incomplete run's summary), the log's column
+/// and the summary as dicts (`None` for an incomplete run's summary), the log's column
 /// names, and its rows with empty cells (not applicable) as `None`. An incomplete run gives
 /// the rows its checkpoint vouches for.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn read_folder(
+    py: Python<'_>,
     dir: PathBuf,
-) -> PyResult<(String, Vec<String>, Vec<Vec<Option<f64>>>, Option<String>)> {
+) -> PyResult<(
+    Bound<'_, PyAny>,
+    Vec<String>,
+    Vec<Vec<Option<f64>>>,
+    Option<Bound<'_, PyAny>>,
+)> {
     let resolved = folder::load_resolved(&dir).map_err(invalid)?;
     let log = Log::read_run(&dir).map_err(invalid)?;
     let rows = log
@@ -165,11 +174,19 @@ fn read_folder(
         .map(|r| r.iter().map(|x| (!x.is_nan()).then_some(*x)).collect())
         .collect();
     let summary = if folder::is_complete(&dir) {
-        Some(json(&folder::read_summary(&dir).map_err(failed)?)?)
+        Some(serialize_to_py(
+            py,
+            &folder::read_summary(&dir).map_err(failed)?,
+        )?)
     } else {
         None
     };
-    Ok((json(&resolved.spec)?, log.columns, rows, summary))
+    Ok((
+        serialize_to_py(py, &resolved.spec)?,
+        log.columns,
+        rows,
+        summary,
+    ))
 }
 
 fn parse_sweep(spec: &str) -> PyResult<SweepSpec> {
@@ -185,17 +202,17 @@ fn parse_shard(shard: Option<&str>) -> PyResult<Shard> {
 
 /// Runs the sweep `spec` (JSON with the keys of a sweep file: `presets`, `seeds`, `sigma0`,
 /// `base`, `variant`) into `out`, the runs in parallel on this machine, optionally only
-/// shard `"I/N"`; returns `sweep.json` as text.
+/// shard `"I/N"`; returns `sweep.json` as a dict.
 #[pyfunction]
 #[pyo3(signature = (out, spec, shard = None, force = false, checkpoint_every = 2000))]
-fn sweep_folder(
-    py: Python<'_>,
+fn sweep_folder<'py>(
+    py: Python<'py>,
     out: PathBuf,
     spec: &str,
     shard: Option<&str>,
     force: bool,
     checkpoint_every: u64,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyAny>> {
     let (file, resolved) =
         sweep::expand(&parse_sweep(spec)?, parse_shard(shard)?).map_err(invalid)?;
     let watch = SignalWatch::new();
@@ -214,7 +231,7 @@ fn sweep_folder(
         )
     })
     .map_err(|e| watch.error(e))?;
-    json(&file)
+    serialize_to_py(py, &file)
 }
 
 /// Creates the sweep folder `out` with its `sweep.json` without running anything, so that
@@ -255,50 +272,65 @@ fn sweep_run(
 }
 
 /// Closes the sweep folder `out` once every run of its shard is complete: writes
-/// `summary.csv` as `sepg sweep` does at its end; returns `sweep.json` as text.
+/// `summary.csv` as `sepg sweep` does at its end; returns `sweep.json` as a dict.
 #[pyfunction]
-fn sweep_finish(out: PathBuf) -> PyResult<String> {
+fn sweep_finish(py: Python<'_>, out: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let file = sweep::finish(&out).map_err(run_error)?;
-    json(&file)
+    serialize_to_py(py, &file)
 }
 
 /// Merges the complete shard folders `shards` of one sweep into `out`; returns the merged
-/// `sweep.json` as text.
+/// `sweep.json` as a dict.
 #[pyfunction]
 #[pyo3(signature = (shards, out, force = false))]
-fn merge_folders(shards: Vec<PathBuf>, out: PathBuf, force: bool) -> PyResult<String> {
+fn merge_folders(
+    py: Python<'_>,
+    shards: Vec<PathBuf>,
+    out: PathBuf,
+    force: bool,
+) -> PyResult<Bound<'_, PyAny>> {
     let file = sepg_runs::merge::merge(&shards, &out, force).map_err(run_error)?;
-    json(&file)
+    serialize_to_py(py, &file)
 }
 
 /// Re-checks the log of the run folder `dir` against its safety requirement (with the exact
-/// oracle where one exists) and returns the report of `sepg audit` as JSON text; `alpha` is
+/// oracle where one exists) and returns the report of `sepg audit` as a dict; `alpha` is
 /// the family-wise level of the binomial tests of a sampled run.
 #[pyfunction]
 #[pyo3(signature = (dir, tolerance = 1e-9, alpha = sepg_runs::audit::DEFAULT_ALPHA))]
-fn audit_folder(dir: PathBuf, tolerance: f64, alpha: f64) -> PyResult<String> {
+fn audit_folder(
+    py: Python<'_>,
+    dir: PathBuf,
+    tolerance: f64,
+    alpha: f64,
+) -> PyResult<Bound<'_, PyAny>> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(format!(
             "tolerance = {tolerance} must be finite and non-negative"
         )));
     }
     let report = sepg_runs::audit::audit(&dir, tolerance, alpha).map_err(run_error)?;
-    json(&report)
+    serialize_to_py(py, &report)
 }
 
 /// The sweep file (TOML) at `path` as JSON text, for [`sweep_folder`] and [`sweep_prepare`].
 #[pyfunction]
 fn read_sweep_file(path: PathBuf) -> PyResult<String> {
-    json(&sweep::read_spec(&path).map_err(invalid)?)
+    serde_json::to_string(&sweep::read_spec(&path).map_err(invalid)?).map_err(failed)
 }
 
 /// Runs the numerical checks of the thesis's statements (`sepg-verification`, as
 /// `sepg verify`): all, or those whose identifier contains `check`; `quick` runs the CI
-/// subset. Returns the report as JSON text (each check's outcome and whether it is the
+/// subset. Returns the report as a dict (each check's outcome and whether it is the
 /// recorded one).
 #[pyfunction]
 #[pyo3(signature = (quick = true, check = None, seed = 0))]
-fn verify(py: Python<'_>, quick: bool, check: Option<&str>, seed: u64) -> PyResult<String> {
+fn verify<'py>(
+    py: Python<'py>,
+    quick: bool,
+    check: Option<&str>,
+    seed: u64,
+) -> PyResult<Bound<'py, PyAny>> {
     let checks = sepg_verification::registry();
     if let Some(f) = check
         && !checks.iter().any(|c| c.meta.id.contains(f))
@@ -307,7 +339,7 @@ fn verify(py: Python<'_>, quick: bool, check: Option<&str>, seed: u64) -> PyResu
     }
     let config = sepg_verification::RunConfig { seed, quick };
     let report = py.detach(|| sepg_verification::run_checks(&checks, &config, check, |_| {}));
-    report.to_json().map_err(failed)
+    serialize_to_py(py, &report)
 }
 
 /// Adds the functions of this module to `m`.

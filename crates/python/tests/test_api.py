@@ -2,6 +2,8 @@
 
 import ast
 import pathlib
+import subprocess
+import sys
 
 import sepg
 from sepg import _native, bounds
@@ -34,3 +36,14 @@ def test_bounds_exports_every_bound_function():
     assert classes <= set(bounds.__all__)
     for name in sepg.__all__:
         assert hasattr(sepg, name), name
+
+
+def test_import_sepg_imports_neither_typing_nor_json_nor_numpy():
+    # What `import sepg.runs` adds to a bare interpreter: the run path of the built-in
+    # environments pays for no module it does not use (docs/PYTHON.md, "Speed").
+    code = "import sys; b = set(sys.modules); import sepg.runs; print(*sorted(set(sys.modules) - b))"
+    added = set(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                               text=True).stdout.split())
+    assert {"sepg", "sepg._native", "sepg.bounds", "sepg.errors", "sepg.runs"} <= added
+    heavy = {"typing", "json", "re", "enum", "numpy", "pandas", "dataclasses", "gymnasium"}
+    assert not heavy & added, heavy & added

@@ -66,6 +66,21 @@ def test_run_read_resume_and_audit(tmp_path):
     assert report["checks"] and report["failures"] == [] and report["status"] == "holds"
 
 
+def test_a_run_returns_its_summary_file_as_a_dict(tmp_path):
+    # The options are converted without Python's json module: numpy scalars are numbers.
+    summary = runs.run(tmp_path / "r", env="lqg1d", algo="sepg-zv", iterations=3, batch=12,
+                       sigma0=np.float64(0.5), seed=np.int64(2))
+    assert summary == json.loads((tmp_path / "r" / "summary.json").read_text())
+    folder = runs.read_run(tmp_path / "r")
+    assert folder.summary == summary and folder.config["seed"] == 2 and folder.config["sigma0"] == 0.5
+    with pytest.raises(sepg.InvalidInputError, match="finite"):
+        runs.run(tmp_path / "a", env="lqg1d", iterations=2, sigma0=float("nan"))
+    with pytest.raises(sepg.InvalidInputError, match="unsupported"):
+        runs.run(tmp_path / "a", env=object())
+    with pytest.raises(sepg.InvalidInputError, match="64-bit"):
+        runs.run(tmp_path / "a", env="lqg1d", seed=2**64)
+
+
 def test_run_options_and_folders_are_checked(tmp_path):
     with pytest.raises(sepg.InvalidInputError, match="unknown field"):
         runs.run(tmp_path / "a", env="lqg1d", iterations=2, batch_size=30)

@@ -13,11 +13,15 @@
 
 Errors are the classes of :mod:`sepg.errors`; bad input raises
 :class:`~sepg.errors.InvalidInputError`, a ``ValueError``. numpy is imported when first
-needed, so that ``import sepg`` stays cheap for runs of the built-in environments.
+needed, and neither ``typing`` nor ``json`` at import, so that ``import sepg`` stays cheap for
+runs of the built-in environments (docs/PYTHON.md, "Speed").
 """
 
-import math
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from __future__ import annotations
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any, Dict, Optional, Sequence, Tuple
 
 from sepg import bounds, errors, runs
 from sepg._native import (
@@ -63,6 +67,8 @@ def required_improvement(
         raise InvalidInputError(
             f"unknown requirement {requirement!r}: expected one of {', '.join(_REQUIREMENTS)}"
         )
+    import math
+
     if not math.isfinite(budget) or budget < 0.0:
         raise InvalidInputError(f"budget = {budget} must be finite and non-negative")
     if requirement == "mi":

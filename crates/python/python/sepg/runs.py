@@ -13,14 +13,18 @@ deterministic unit wherever it runs, so the folder is byte-identical to a sweep 
 machine (wall-clock figures in ``summary.json`` aside).
 """
 
-import json
+from __future__ import annotations
+
 import os
-from typing import Any, Dict, List, Optional, Sequence, Union
 
 from sepg import _native
 from sepg.errors import InvalidInputError
 
-PathLike = Union[str, "os.PathLike[str]"]
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any, Dict, List, Optional, Sequence, Union
+
+    PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _kebab(options: Dict[str, Any]) -> Dict[str, Any]:
@@ -29,6 +33,8 @@ def _kebab(options: Dict[str, Any]) -> Dict[str, Any]:
 
 def _spec_json(spec: Union[PathLike, Dict[str, Any]]) -> str:
     if isinstance(spec, dict):
+        import json
+
         out = _kebab(spec)
         if isinstance(out.get("base"), dict):
             out["base"] = _kebab(out["base"])
@@ -51,20 +57,18 @@ def run(
     ``sepg run --out out`` with the same options; ``config`` is a TOML file of options that
     ``options`` override. Returns the summary. Ctrl-C stops the run after checkpointing
     (resume it with :func:`resume`)."""
-    return json.loads(
-        _native.run_folder(
-            os.fspath(out),
-            json.dumps(_kebab(options)),
-            None if config is None else os.fspath(config),
-            force,
-            checkpoint_every,
-        )
+    return _native.run_folder(
+        os.fspath(out),
+        _kebab(options),
+        None if config is None else os.fspath(config),
+        force,
+        checkpoint_every,
     )
 
 
 def resume(dir: PathLike, *, checkpoint_every: int = 500) -> Dict[str, Any]:
     """Resumes the run folder ``dir`` from its checkpoint, bit for bit; returns the summary."""
-    return json.loads(_native.resume_folder(os.fspath(dir), checkpoint_every))
+    return _native.resume_folder(os.fspath(dir), checkpoint_every)
 
 
 class RunFolder:
@@ -78,8 +82,8 @@ class RunFolder:
 
         config, columns, rows, summary = _native.read_folder(os.fspath(dir))
         self.dir = os.fspath(dir)
-        self.config: Dict[str, Any] = json.loads(config)
-        self.summary: Optional[Dict[str, Any]] = None if summary is None else json.loads(summary)
+        self.config: Dict[str, Any] = config
+        self.summary: Optional[Dict[str, Any]] = summary
         self.complete = self.summary is not None
         self.columns: List[str] = list(columns)
         self.log: Dict[str, Any] = {}
@@ -163,7 +167,7 @@ def sweep(
     out = os.fspath(out)
     chosen = _engine(engine)
     if chosen == "local":
-        return json.loads(_native.sweep_folder(out, text, shard, force, checkpoint_every))
+        return _native.sweep_folder(out, text, shard, force, checkpoint_every)
     indices = _native.sweep_prepare(out, text, shard, force)
     if chosen == "dask":
         import dask
@@ -174,19 +178,19 @@ def sweep(
 
         task = ray.remote(_sweep_run)
         ray.get([task.remote(out, i, checkpoint_every) for i in indices])
-    return json.loads(_native.sweep_finish(out))
+    return _native.sweep_finish(out)
 
 
 def merge(shards: Sequence[PathLike], out: PathLike, *, force: bool = False) -> Dict[str, Any]:
     """Merges the complete shard folders of one sweep into ``out``, as ``sepg merge``."""
-    return json.loads(_native.merge_folders([os.fspath(s) for s in shards], os.fspath(out), force))
+    return _native.merge_folders([os.fspath(s) for s in shards], os.fspath(out), force)
 
 
 def audit(dir: PathLike, *, tolerance: float = 1e-9, alpha: float = 0.01) -> Dict[str, Any]:
     """Re-checks the run folder's log against its safety requirement, as ``sepg audit``:
     the report has each check with its failures and a ``status``; ``alpha`` is the
     family-wise level of the binomial tests of a sampled run."""
-    return json.loads(_native.audit_folder(os.fspath(dir), tolerance, alpha))
+    return _native.audit_folder(os.fspath(dir), tolerance, alpha)
 
 
 def verify(*, quick: bool = True, check: Optional[str] = None, seed: int = 0) -> Dict[str, Any]:
@@ -194,7 +198,7 @@ def verify(*, quick: bool = True, check: Optional[str] = None, seed: int = 0) ->
     or those whose identifier contains ``check``; ``quick`` is the CI subset. Returns the
     report; ``report["results"][i]["as_expected"]`` says whether each outcome is the one
     recorded."""
-    return json.loads(_native.verify(quick, check, seed))
+    return _native.verify(quick, check, seed)
 
 
 exact = _native.exact
