@@ -102,6 +102,14 @@ impl PyStepOutcome {
         }
     }
 
+    /// Whether `x` lies in the safe interval `[lo, hi]` (`False` unless feasible).
+    fn contains(&self, x: f64) -> bool {
+        match self.0 {
+            StepOutcome::Feasible(s) => s.contains(x),
+            _ => false,
+        }
+    }
+
     fn __repr__(&self) -> String {
         let opt = |x: Option<f64>| x.map_or("None".to_string(), |v| format!("{v:?}"));
         format!(
@@ -392,6 +400,10 @@ bound_fns! {
     /// The certified exploring w-step along ∇̂_w L (`exploring_w_exploring_step`).
     fn certified_exploring_safe_step(k: k, sigma: f64, grad_w_j_hat: f64, eps_j: f64, grad_w_l_hat: f64, required: f64)
         -> PyCertified = certified::exploring_safe_step;
+    /// The adaptive step of Corollary 3.11 (`pirotta_optimal_step`) with the Theorem 3.10
+    /// bound at that step enclosed in interval arithmetic: `bound.lo` is a guarantee in exact
+    /// arithmetic (there is no requirement; the guarantee is what the step attains).
+    fn certified_adaptive_step(k: k, sigma: f64, grad: vec) -> PyCertified = certified::adaptive_step;
 
     /// The split (C_v, C_w) = ((1 − ν)C, νC) of a required improvement (eqs. 4.13, 4.14).
     fn budget_split_requirement(required: f64, nu: f64) -> (f64, f64) = budget::split_requirement;
@@ -681,6 +693,13 @@ impl PyInterval {
         exact(x, "x").map(PyInterval)
     }
 
+    /// The whole real line (−∞, +∞), the enclosure of an unknown value.
+    #[classattr]
+    #[allow(non_snake_case)]
+    fn ENTIRE() -> Self {
+        PyInterval(Interval::ENTIRE)
+    }
+
     /// The lower end point.
     #[getter]
     fn lo(&self) -> f64 {
@@ -733,6 +752,15 @@ impl PyInterval {
     fn scale(&self, x: f64) -> PyResult<Self> {
         exact(x, "x")?;
         Ok(PyInterval(self.0.scale(x)))
+    }
+
+    /// The enclosure of |x| (exact end points).
+    fn abs(&self) -> Self {
+        PyInterval(self.0.abs())
+    }
+
+    fn __abs__(&self) -> Self {
+        self.abs()
     }
 
     /// The enclosure of max(self, other).
@@ -846,6 +874,16 @@ impl PyCertified {
     fn ulps_moved(&self) -> Option<u64> {
         match self.0 {
             Certified::Step(s) => Some(s.ulps_moved),
+            _ => None,
+        }
+    }
+
+    /// Whether the certificate came from the a-priori rounding-error bound of the float
+    /// evaluation rather than from interval arithmetic (`kind == "step"` only).
+    #[getter]
+    fn by_error_bound(&self) -> Option<bool> {
+        match self.0 {
+            Certified::Step(s) => Some(s.by_error_bound),
             _ => None,
         }
     }
@@ -1070,6 +1108,131 @@ impl PyEnclosure {
     }
 }
 
+/// The concave parabola B(x) = a·x − b·x² (b ≥ 0) of Theorems 4.2, 4.3 and 4.5 with its
+/// coefficients a (`linear`) and b (`quadratic`) enclosed in intervals, and the enclosures
+/// of the quantities of the safe steps: C_max = a²/(4b), the vertex a/(2b), λ = √(1 − C/C_max)
+/// (eqs. (4.10), (4.17), (4.19)) and the end points of {x : B(x) ≥ C}.
+#[pyclass(frozen, name = "Quadratic", module = "sepg")]
+#[derive(Debug, Clone, Copy)]
+pub struct PyQuadratic(Quadratic);
+
+#[pymethods]
+impl PyQuadratic {
+    /// The parabola with coefficients a = `linear` and b = `quadratic` (intervals, or floats
+    /// taken as exact); raises `InvalidInputError` when b can be negative (`quadratic.lo < 0`).
+    #[new]
+    fn new(linear: &Bound<'_, PyAny>, quadratic: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (linear, quadratic) = (operand(linear)?, operand(quadratic)?);
+        if quadratic.lo() < 0.0 {
+            return Err(invalid(format!(
+                "the quadratic coefficient b = [{}, {}] must be non-negative",
+                quadratic.lo(),
+                quadratic.hi()
+            )));
+        }
+        Ok(PyQuadratic(Quadratic { linear, quadratic }))
+    }
+
+    /// Theorem 4.2: a = ‖∇_vJ‖∞², b = c(σ)‖∇_vJ‖∞².
+    #[staticmethod]
+    fn v_update(k: K<'_>, sigma: f64, grad_v: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let g = vector(grad_v, "grad_v")?;
+        Quadratic::v_update(&k.0, sigma, &g)
+            .map(PyQuadratic)
+            .map_err(invalid)
+    }
+
+    /// Theorem 4.3: a = (∇_wJ)², b = d(σ)(∇_wJ)².
+    #[staticmethod]
+    fn w_along_j(k: K<'_>, sigma: f64, grad_w_j: f64) -> PyResult<Self> {
+        Quadratic::w_along_j(&k.0, sigma, grad_w_j)
+            .map(PyQuadratic)
+            .map_err(invalid)
+    }
+
+    /// Theorem 4.5: a = ∇_wL ∇_wJ, b = d(σ)(∇_wL)².
+    #[staticmethod]
+    fn w_along_l(k: K<'_>, sigma: f64, grad_w_j: f64, grad_w_l: f64) -> PyResult<Self> {
+        Quadratic::w_along_l(&k.0, sigma, grad_w_j, grad_w_l)
+            .map(PyQuadratic)
+            .map_err(invalid)
+    }
+
+    /// The enclosure of the linear coefficient a.
+    #[getter]
+    fn linear(&self) -> PyInterval {
+        PyInterval(self.0.linear)
+    }
+
+    /// The enclosure of the quadratic coefficient b ≥ 0.
+    #[getter]
+    fn quadratic(&self) -> PyInterval {
+        PyInterval(self.0.quadratic)
+    }
+
+    /// An enclosure of C_max = a²/(4b), the value at the vertex.
+    fn c_max(&self) -> PyInterval {
+        PyInterval(self.0.c_max())
+    }
+
+    /// An enclosure of the vertex a/(2b).
+    fn vertex(&self) -> PyInterval {
+        PyInterval(self.0.vertex())
+    }
+
+    /// An enclosure of λ = √(1 − C/C_max) for C = `required` ≤ C_max (eqs. (4.10), (4.17),
+    /// (4.19)); `lambda` is a keyword of Python, hence the underscore.
+    #[pyo3(name = "lambda_")]
+    fn lambda(&self, required: f64) -> PyResult<PyInterval> {
+        Ok(PyInterval(self.0.lambda(finite_required(required)?)))
+    }
+
+    /// Enclosures `(lo, hi)` of the end points of {x : a x − b x² ≥ C} for C = `required`, or
+    /// `None` when the enclosure cannot exclude C > C_max.
+    fn end_points(&self, required: f64) -> PyResult<Option<(PyInterval, PyInterval)>> {
+        Ok(self
+            .0
+            .end_points(finite_required(required)?)
+            .map(|(lo, hi)| (PyInterval(lo), PyInterval(hi))))
+    }
+
+    /// An interval that contains the exact B(x), x a finite step.
+    fn enclose(&self, x: f64) -> PyResult<PyInterval> {
+        if !x.is_finite() {
+            return Err(invalid(format!("x must be finite, got {x}")));
+        }
+        Ok(PyInterval(self.0.enclose(x)))
+    }
+
+    /// The same bound as an `Enclosure`, to certify a step with.
+    fn enclosure(&self) -> PyEnclosure {
+        PyEnclosure(Form::Quadratic(self.0))
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.0 == other.0
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Quadratic(linear=Interval({:?}, {:?}), quadratic=Interval({:?}, {:?}))",
+            self.0.linear.lo(),
+            self.0.linear.hi(),
+            self.0.quadratic.lo(),
+            self.0.quadratic.hi()
+        )
+    }
+}
+
+/// `required` when finite, else `InvalidInputError`.
+fn finite_required(required: f64) -> PyResult<f64> {
+    if required.is_finite() {
+        Ok(required)
+    } else {
+        Err(invalid(format!("required must be finite, got {required}")))
+    }
+}
+
 /// The lower bound of the exploring w-update (Theorem 4.3 on the confidence event of ∇_w J,
 /// Assumption 4.6): B(Δw) = Δw∇̂_wJ − |Δw|ε_J − d(σ)Δw², uniform in Δw.
 #[pyclass(frozen, name = "ExploringBound", module = "sepg")]
@@ -1133,6 +1296,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyInterval>()?;
     m.add_class::<PyCertified>()?;
     m.add_class::<PyEnclosure>()?;
+    m.add_class::<PyQuadratic>()?;
     m.add_class::<PyExploringBound>()?;
     m.add_function(wrap_pyfunction!(constants_psi, m)?)?;
     m.add_function(wrap_pyfunction!(rigorous_k_w, m)?)?;

@@ -122,9 +122,32 @@ impl PyTaskConstants {
         self.0.action_volume()
     }
 
+    /// The same constants with ψ replaced by `psi` in d(σ) (Theorem 4.3): the guarantees hold
+    /// for any ψ ≥ Lemma A.1's value (`sepg.bounds.constants_psi()`), a smaller one voids
+    /// them. Raises `InvalidInputError` unless `psi` is finite and positive.
+    fn with_psi(&self, psi: f64) -> PyResult<Self> {
+        self.0.with_psi(psi).map(PyTaskConstants).map_err(invalid)
+    }
+
+    /// The ψ that replaces Lemma A.1's value (`with_psi`), or `None`.
+    #[getter]
+    fn psi_override(&self) -> Option<f64> {
+        self.0.psi_override()
+    }
+
+    /// The ψ that d(σ) (Theorem 4.3) uses: the override, or Lemma A.1's value.
+    #[getter]
+    fn psi_used(&self) -> f64 {
+        self.0.psi_used()
+    }
+
     fn __repr__(&self) -> String {
+        let psi = self
+            .0
+            .psi_override()
+            .map_or(String::new(), |p| format!(", psi={p:?}"));
         format!(
-            "TaskConstants(gamma={:?}, r_max={:?}, m_phi={:?}, action_volume={:?})",
+            "TaskConstants(gamma={:?}, r_max={:?}, m_phi={:?}, action_volume={:?}{psi})",
             self.0.gamma(),
             self.0.r_max(),
             self.0.m_phi(),

@@ -30,9 +30,10 @@ def test_bounds_exports_every_bound_function():
     native = {n for n in dir(_native) if n.startswith(prefixes)}
     assert native <= set(bounds.__all__)
     # 43 functions of the closed forms, 5 more of the rigorous module (K_W, K_MU, the sound
-    # c and its v-steps), the exploring w-step, and 13 of the certified module.
-    assert len(native) == 43 + 5 + 1 + 13
-    classes = {"Budget", "Certified", "Enclosure", "ExploringBound", "HighProbabilityBound", "Interval", "StepOutcome"}
+    # c and its v-steps), the exploring w-step, and 14 of the certified module.
+    assert len(native) == 43 + 5 + 1 + 14
+    classes = {"Budget", "Certified", "Enclosure", "ExploringBound", "HighProbabilityBound", "Interval",
+               "Quadratic", "StepOutcome"}
     assert classes <= set(bounds.__all__)
     for name in sepg.__all__:
         assert hasattr(sepg, name), name

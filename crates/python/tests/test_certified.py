@@ -229,6 +229,130 @@ def test_an_enclosure_certifies_the_float_outcome_of_its_bound():
     assert r.enclose(-0.2).contains(bounds.rigorous_bound(K, sigma, 0.5, -0.1)) or r.enclose(-0.2).lo <= bounds.rigorous_bound(K, sigma, 0.5, -0.1)
 
 
+def inside(interval, exact):
+    """Whether the interval contains the exact (Decimal) value."""
+    return Decimal(interval.lo) <= exact <= Decimal(interval.hi)
+
+
+def psi_decimal():
+    r7 = Decimal(7).sqrt()
+    return 4 * (r7 - 2) * (r7 / 2 - 2).exp() / (2 * PI).sqrt()
+
+
+def d_decimal(k, sigma, psi=None):
+    """d(sigma) of Theorem 4.3 (eq. 4.15) in 50-digit decimals, with Lemma A.1's psi unless
+    ``psi`` is given."""
+    g, r, a, s = (Decimal(x) for x in (k.gamma, k.r_max, k.action_volume, sigma))
+    psi = psi_decimal() if psi is None else Decimal(psi)
+    one = Decimal(1)
+    return r / (one - g) ** 2 * (psi * a / (2 * s) + g / (one - g))
+
+
+def test_a_quadratic_encloses_its_vertex_c_max_lambda_and_end_points():
+    # B(x) = a x - b x^2 with the exact reals of the floats +-0.3 and 0.7, solved by hand in
+    # 50-digit decimals: vertex a/(2b), C_max = a^2/(4b), lambda = sqrt(1 - C/C_max), and
+    # the roots of B(x) = C, (a + s sqrt(a^2 - 4bC))/(2b) and its Vieta partner
+    # 2C/(a + s sqrt(a^2 - 4bC)) (s = sign a; the form without cancellation, so that 50
+    # digits give the small root to 50 digits too).
+    for a_float in (0.3, -0.3):
+        q = bounds.Quadratic(a_float, bounds.Interval.point(0.7))
+        a, b = Decimal(a_float), Decimal(0.7)
+        c_max = a * a / (4 * b)
+        assert inside(q.c_max(), c_max) and inside(q.vertex(), a / (2 * b))
+        assert inside(q.linear, a) and inside(q.quadratic, b)
+        for required in (-0.05, 0.0, 0.01, 0.032):  # C_max = 0.03214...
+            c = Decimal(required)
+            assert inside(q.lambda_(required), (1 - c / c_max).sqrt())
+            far = a + (1 if a > 0 else -1) * (a * a - 4 * b * c).sqrt()
+            roots = sorted((far / (2 * b), 2 * c / far))
+            lo, hi = q.end_points(required)
+            assert inside(lo, roots[0]) and inside(hi, roots[1])
+            for end in (lo, hi):
+                assert end.width <= 1e-14 * max(abs(end.lo), abs(end.hi)) + 1e-300
+        assert q.end_points(0.033) is None
+        for x in (-1.0, 0.0, 0.25):
+            assert inside(q.enclose(x), a * Decimal(x) - b * Decimal(x) ** 2)
+    assert bounds.Quadratic(bounds.Interval(0.29, 0.31), 0.7).c_max().width > 1e-3
+
+
+def test_the_quadratic_factories_hold_the_coefficients_of_theorems_4_2_to_4_5():
+    sigma, gv, j, l = 0.7, [0.3, -0.8], 0.4, -1.2
+    c, d = c_decimal(K, sigma), d_decimal(K, sigma)
+    n2 = Decimal(-0.8) ** 2
+    q = bounds.Quadratic.v_update(K, sigma, gv)
+    assert inside(q.linear, n2) and inside(q.quadratic, c * n2)
+    assert inside(q.c_max(), n2 / (4 * c)) and inside(q.vertex(), 1 / (2 * c))
+    qj = bounds.Quadratic.w_along_j(K, sigma, j)
+    assert inside(qj.linear, Decimal(j) ** 2) and inside(qj.quadratic, d * Decimal(j) ** 2)
+    ql = bounds.Quadratic.w_along_l(K, sigma, j, l)
+    assert inside(ql.linear, Decimal(j) * Decimal(l)) and inside(ql.quadratic, d * Decimal(l) ** 2)
+    # The same bound as the Enclosure of the same theorem, and it certifies the float step.
+    assert ql.enclose(-0.1) == bounds.Enclosure.quadratic_w_along_l(K, sigma, j, l).enclose(-0.1)
+    o = ql.enclosure().certify(bounds.w_update_safe_step_along_l(K, sigma, j, l, -0.01), -0.01)
+    assert o.kind == "step" and ql.enclose(o.chosen_step).lo >= -0.01
+    assert q == bounds.Quadratic.v_update(K, sigma, gv) and q != qj
+    with pytest.raises(sepg.InvalidInputError, match="non-negative"):
+        bounds.Quadratic(0.3, bounds.Interval(-0.1, 0.7))
+    with pytest.raises(sepg.InvalidInputError):
+        q.lambda_(math.nan)
+    with pytest.raises(sepg.InvalidInputError):
+        q.end_points(math.inf)
+    with pytest.raises(sepg.InvalidInputError):
+        bounds.Quadratic.w_along_j(K, 1.0, math.nan)
+
+
+def test_the_entire_line_and_the_absolute_value():
+    entire = bounds.Interval.ENTIRE
+    assert (entire.lo, entire.hi) == (-math.inf, math.inf) and not entire.is_finite()
+    assert entire == bounds.Interval(-math.inf, math.inf) and entire.contains(-1e308)
+    # A divisor that contains 0 gives the whole line; it absorbs any operation.
+    assert bounds.Interval.point(1.0) / bounds.Interval(-1.0, 1.0) == entire
+    assert entire + 1.0 == entire and entire * 2.0 == entire
+    assert abs(entire) == bounds.Interval(0.0, math.inf)
+    assert abs(bounds.Interval(-3.0, 2.0)) == bounds.Interval(0.0, 3.0)
+    assert bounds.Interval(-3.0, -2.0).abs() == bounds.Interval(2.0, 3.0)
+    assert bounds.Interval(0.5, 2.0).abs() == bounds.Interval(0.5, 2.0)
+
+
+def test_a_psi_override_replaces_lemma_a1_in_d():
+    assert K.psi_override is None
+    # Lemma A.1's psi as computed in floats: within a few ulps of the 50-digit value.
+    assert abs(Decimal(K.psi_used) - psi_decimal()) <= 4 * Decimal(math.ulp(K.psi_used))
+    k = K.with_psi(0.53)
+    assert (k.psi_override, k.psi_used) == (0.53, 0.53) and k != K
+    for sigma in (0.3, 2.0):
+        assert bounds.constants_d(k, sigma) == pytest.approx(float(d_decimal(k, sigma, psi=0.53)), rel=1e-14)
+        assert inside(bounds.certified_d(k, sigma), d_decimal(k, sigma, psi=0.53))
+    assert bounds.constants_c(k, 1.0) == bounds.constants_c(K, 1.0)
+    for bad in (0.0, -1.0, math.nan, math.inf):
+        with pytest.raises(sepg.InvalidInputError):
+            K.with_psi(bad)
+
+
+def test_the_certified_adaptive_step_encloses_the_theorem_3_10_bound():
+    # alpha* = |g|_2^2 / (2 c |g|_1^2) (Corollary 3.11); B(alpha) = alpha |g|_2^2 - alpha^2 c |g|_1^2.
+    sigma, grad = 0.7, [0.3, -0.5]
+    c = c_decimal(K, sigma)
+    n2 = sum(Decimal(g) ** 2 for g in grad)
+    n1 = sum(abs(Decimal(g)) for g in grad)
+    o = bounds.certified_adaptive_step(K, sigma, grad)
+    alpha = Decimal(o.chosen_step)
+    assert o.kind == "step" and o.ulps_moved == 0 and o.by_error_bound in (True, False)
+    assert abs(alpha - n2 / (2 * c * n1 * n1)) <= Decimal("1e-15") * alpha
+    assert inside(o.bound, alpha * n2 - alpha * alpha * c * n1 * n1) and o.bound.lo > 0
+    zero = bounds.certified_adaptive_step(K, sigma, [0.0, 0.0])
+    assert zero.kind == "zero_gradient" and zero.by_error_bound is None
+
+
+def test_a_step_outcome_contains_its_safe_interval_only():
+    o = bounds.v_update_safe_step(K, 1.0, [0.5], 0.0)
+    assert o.kind == "feasible"
+    assert o.contains(o.lo) and o.contains(o.hi) and o.contains(o.vertex)
+    assert not o.contains(o.hi * 1.01) and not o.contains(-1e-3)
+    cmax = bounds.v_update_c_max(K, 1.0, [0.5])
+    assert not bounds.v_update_safe_step(K, 1.0, [0.5], 2 * cmax).contains(0.0)
+
+
 @pytest.mark.parametrize(
     "call",
     [

@@ -22,8 +22,9 @@ prefix                        thesis
 :class:`ExploringBound`       event of grad_w J (Assumption 4.6)
 ``certified_``,               certified steps: Theorems 4.2-4.9, the rigorous and the
 :class:`Interval`,            exploring bounds evaluated in outward-rounded interval
-:class:`Enclosure`,           arithmetic; the outcome "uncertifiable" when C is within
-:class:`Certified`            rounding of C_max (docs/THEOREMS.md, "Certified steps")
+:class:`Quadratic`,           arithmetic; the outcome "uncertifiable" when C is within
+:class:`Enclosure`,           rounding of C_max (docs/THEOREMS.md, "Certified steps");
+:class:`Certified`            the adaptive step of Corollary 3.11 with its guarantee
 ``budget_``, :class:`Budget`  Definition 4.3, Theorem 4.1, eqs. (4.13)-(4.14)
 ============================  ==========================================================
 
@@ -37,11 +38,13 @@ from sepg._native import (
     ExploringBound,
     HighProbabilityBound,
     Interval,
+    Quadratic,
     StepOutcome,
     TaskConstants,
     batch_size_gpomdp,
     batch_size_reinforce,
     budget_split_requirement,
+    certified_adaptive_step,
     certified_c,
     certified_d,
     certified_exploring_safe_step,
@@ -110,11 +113,13 @@ __all__ = [
     "ExploringBound",
     "HighProbabilityBound",
     "Interval",
+    "Quadratic",
     "StepOutcome",
     "TaskConstants",
     "batch_size_gpomdp",
     "batch_size_reinforce",
     "budget_split_requirement",
+    "certified_adaptive_step",
     "certified_c",
     "certified_d",
     "certified_exploring_safe_step",
