@@ -337,11 +337,21 @@ def test_the_certified_adaptive_step_encloses_the_theorem_3_10_bound():
     n1 = sum(abs(Decimal(g)) for g in grad)
     o = bounds.certified_adaptive_step(K, sigma, grad)
     alpha = Decimal(o.chosen_step)
-    assert o.kind == "step" and o.ulps_moved == 0 and o.by_error_bound in (True, False)
+    # The guarantee is an interval evaluation, not the a-priori error bound of the fast path.
+    assert o.kind == "step" and o.ulps_moved == 0 and o.by_error_bound is False
     assert abs(alpha - n2 / (2 * c * n1 * n1)) <= Decimal("1e-15") * alpha
     assert inside(o.bound, alpha * n2 - alpha * alpha * c * n1 * n1) and o.bound.lo > 0
     zero = bounds.certified_adaptive_step(K, sigma, [0.0, 0.0])
     assert zero.kind == "zero_gradient" and zero.by_error_bound is None
+    # An ordinary v-step (lqg1d's constants) is certified by the error bound of its float
+    # evaluation; the same outcome certified through its enclosure is an interval search.
+    lqg1d = sepg.TaskConstants(0.99, 28.8, 4.0, 8.0)
+    fast = bounds.certified_v_safe_step(lqg1d, 0.5, [-3.7], 0.0)
+    assert fast.kind == "step" and fast.by_error_bound is True
+    searched = bounds.Quadratic.v_update(lqg1d, 0.5, [-3.7]).enclosure().certify(
+        bounds.v_update_safe_step(lqg1d, 0.5, [-3.7], 0.0), 0.0
+    )
+    assert searched.kind == "step" and searched.by_error_bound is False
 
 
 def test_a_step_outcome_contains_its_safe_interval_only():

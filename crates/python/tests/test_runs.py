@@ -71,6 +71,7 @@ def test_a_run_returns_its_summary_file_as_a_dict(tmp_path):
     summary = runs.run(tmp_path / "r", env="lqg1d", algo="sepg-zv", iterations=3, batch=12,
                        sigma0=np.float64(0.5), seed=np.int64(2))
     assert summary == json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert type(summary["iterations"]) is int and type(summary["final"]["v"][0]) is float
     folder = runs.read_run(tmp_path / "r")
     assert folder.summary == summary and folder.config["seed"] == 2 and folder.config["sigma0"] == 0.5
     with pytest.raises(sepg.InvalidInputError, match="finite"):
