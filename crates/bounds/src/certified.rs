@@ -829,7 +829,7 @@ fn certify_predicted(
         let ulp = (toward(1) - s.hi).abs();
         // the shortfall is positive, so `predicted` is ≥ 0, +∞ or NaN; 2⁵² bounds the cast
         let predicted = (required - first.lo()) / (bound.slope(s.hi)?.abs() * ulp);
-        if !(predicted < 4_503_599_627_370_496.0) {
+        if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         // below 2⁵³ the conversion through i64 is exact and branch-free
