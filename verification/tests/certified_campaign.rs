@@ -2,7 +2,8 @@
 //!
 //! CI runs `campaign_small` (512 random configurations and the adversarial grid of 1,440,
 //! each in all 13 bound forms: about 15 s of CPU). The full campaign, 10⁶ random configurations
-//! per bound form (an estimated 30–45 CPU-minutes; run it niced, its table goes to stdout):
+//! per bound form (about 130 CPU-minutes; run it niced, its running totals go to stderr after
+//! each of 40 blocks, its table to stdout):
 //!
 //! ```text
 //! cargo test --release -p sepg-verification --test certified_campaign -- --ignored --nocapture
