@@ -28,7 +28,8 @@
 //!
 //!   Both counts need every intermediate result to be a normal number: that holds when R,
 //!   M_φ, |A| and σ lie in [2⁻¹⁰⁰, 2¹⁰⁰] and γ = 0 or γ ≥ 2⁻¹⁰⁰ (every intermediate then lies
-//!   within 2^±810), which [`apriori_box`] checks; outside it the interval path is used.
+//!   within 2^±810), which [`apriori_box`] checks (the part on R, M_φ, |A|, γ once, when the
+//!   [`TaskConstants`] are built: [`task_in_box`]); outside it the interval path is used.
 //! - Further products are checked one at a time: a product whose result is normal obeys the
 //!   model ([`Rounded::mul`] returns `None` otherwise).
 //! - **The parabola at an exact x** ([`RoundedBound::enclose`]). With â = a(1 + θ_a),
@@ -43,8 +44,13 @@
 //!   (1 − u)²·31 ≥ 4, [fl(r − e), fl(r + e)] encloses p(x): the three extra units of u absorb
 //!   the roundings of e and of its end points, the added 2⁻¹⁰⁷⁰ the underflow terms.
 //!
-//! When fl(x·x) is not normal, or anything overflows, the same parabola is evaluated in
-//! interval arithmetic with its coefficients widened by (k+4)u ([`RoundedBound::widened`]).
+//! A [`RoundedBound`] has one b and a linear coefficient for each side of 0; k is the largest
+//! count of the three. Two comparisons select the case above: fl(x·x) ≥ 2⁻¹⁰²² (a
+//! non-negative square is normal unless below that or infinite) and e ≤ `f64::MAX` (an infinite
+//! fl(x·x), t₁ or t₂ makes e infinite or NaN, which fails the comparison, and a finite e bounds
+//! |r| ≤ fl(|t₁| + |t₂|)). When they fail (x = 0, fl(x·x) not normal, an overflow), the same
+//! parabola is evaluated in interval arithmetic with its coefficients widened by (k+4)u
+//! ([`RoundedBound::widened`]).
 //! The exact-arithmetic campaign (`verification/src/campaign`) checks every enclosure of both
 //! paths against a 256-bit evaluation from independent formulas.
 
