@@ -2,7 +2,7 @@
 //!
 //! CI runs `campaign_small` (512 random configurations and the adversarial grid of 1,440,
 //! each in all 13 bound forms: about 15 s of CPU). The full campaign, 10⁶ random configurations
-//! per bound form (about 130 CPU-minutes; run it niced, its running totals go to stderr after
+//! per bound form (about 90 CPU-minutes; run it niced, its running totals go to stderr after
 //! each of 40 blocks, its table to stdout):
 //!
 //! ```text
