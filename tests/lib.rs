@@ -2,6 +2,7 @@
 
 mod cli_audit;
 mod cli_bounds;
+mod cli_certified;
 mod cli_cluster;
 mod cli_errors;
 mod cli_exact;

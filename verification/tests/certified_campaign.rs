@@ -2,12 +2,15 @@
 //!
 //! CI runs `campaign_small` (512 random configurations and the adversarial grid of 1,440,
 //! each in all 13 bound forms: about 15 s of CPU). The full campaign, 10⁶ random configurations
-//! per bound form (an estimated 30–45 CPU-minutes; run it niced, its table goes to stdout):
+//! per bound form (about 90 CPU-minutes; run it niced, its running totals go to stderr after
+//! each of 40 blocks, its table to stdout):
 //!
 //! ```text
 //! cargo test --release -p sepg-verification --test certified_campaign -- --ignored --nocapture
 //! ```
-use sepg_verification::campaign::{CampaignConfig, FormTally, adversarial_len, run};
+use sepg_verification::campaign::{
+    CampaignConfig, FormTally, adversarial_len, merge, run, run_adversarial, run_random,
+};
 
 fn print(tallies: &[FormTally]) {
     println!(
@@ -82,11 +85,34 @@ fn campaign_small() {
 #[test]
 #[ignore = "full campaign, minutes: see the module docs"]
 fn campaign_full() {
-    let tallies = run(&CampaignConfig {
-        seed: 16,
-        random: 1_000_000,
-        adversarial: true,
-    });
+    const RANDOM: u64 = 1_000_000;
+    // 40 blocks of 25,000 configurations (chunks of 256 each, the same streams as one `run`):
+    // each block's running totals go to stderr, so that an interrupted campaign says how far
+    // it got
+    const CHUNKS: u64 = RANDOM.div_ceil(256);
+    const BLOCKS: u64 = 40;
+    let block = |b: u64| CHUNKS * b / BLOCKS..CHUNKS * (b + 1) / BLOCKS;
+    let mut tallies = run_random(16, RANDOM, block(0));
+    for b in 0..BLOCKS {
+        if b > 0 {
+            merge(&mut tallies, run_random(16, RANDOM, block(b)));
+        }
+        let sum = |f: fn(&FormTally) -> u64| tallies.iter().map(f).sum::<u64>();
+        eprintln!(
+            "random configurations done: {} of {RANDOM}; certified steps {}, certified violations {}, undecided {}, enclosure failures {}",
+            (block(b).end * 256).min(RANDOM),
+            sum(|t| t.certified_steps),
+            sum(|t| t.certified_violations),
+            sum(|t| t.undecided),
+            sum(|t| t.enclosure_failures)
+        );
+    }
+    merge(&mut tallies, run_adversarial(RANDOM));
     print(&tallies);
     assert_clean(&tallies);
+    assert!(
+        tallies
+            .iter()
+            .all(|t| t.cases == RANDOM + adversarial_len())
+    );
 }

@@ -39,7 +39,7 @@ use crate::exploring::ExploringBound;
 use crate::high_probability::{self as hp, HpForm};
 use crate::interval::{Interval, from_ordered_key, ordered_key};
 use crate::outcome::{SafeInterval, StepOutcome};
-use crate::rounding::{self, Parabola, Rounded, RoundedBound};
+use crate::rounding::{self, Rounded, RoundedBound};
 use crate::{pirotta, rigorous, v_update, w_update};
 
 /// Ulps walked one at a time around the predicted move before bisecting or doubling.
@@ -760,6 +760,7 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
 /// Certifies `outcome` with the fast a-priori enclosure `fast` (module `rounding`) when it
 /// applies and certifies a step, and otherwise with the interval enclosure `interval` (`None`:
 /// below noise). The body shared by every certified step form.
+#[inline(always)]
 fn certify_fast_then_interval<S: EnclosedBound>(
     outcome: StepOutcome,
     required: f64,
@@ -776,6 +777,18 @@ fn certify_fast_then_interval<S: EnclosedBound>(
     if let Some(certified) = fast().and_then(|bound| certify_predicted(&bound, outcome, required)) {
         return Ok(certified);
     }
+    certify_by_interval(outcome, required, interval)
+}
+
+/// The interval path of [`certify_fast_then_interval`], kept out of line: it is rarely taken,
+/// and inlined it would crowd the registers of the fast path.
+#[cold]
+#[inline(never)]
+fn certify_by_interval<S: EnclosedBound>(
+    outcome: StepOutcome,
+    required: f64,
+    interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
+) -> Result<Certified, BoundsError> {
     Ok(match interval()? {
         Some(bound) => certify(&bound, outcome, required),
         None => Certified::BelowNoise,
@@ -788,6 +801,7 @@ fn certify_fast_then_interval<S: EnclosedBound>(
 /// evaluations and no search). The error-bound enclosure is wider than the interval one, so
 /// the move is longer than the interval path's (about twice as many ulps, ≲ 1e-14 relative).
 /// `None` when neither passes: the caller then searches in interval arithmetic.
+#[inline(always)]
 fn certify_predicted(
     bound: &RoundedBound,
     outcome: StepOutcome,
@@ -807,19 +821,20 @@ fn certify_predicted(
     let (step, enclosure, ulps_moved) = if first.lo() >= required {
         (s.hi, first, 0)
     } else {
-        let (start, end) = (ordered_key(s.hi), ordered_key(s.vertex));
+        let (from, to) = (ordered_key(s.hi), ordered_key(s.vertex));
         let toward = |n: u64| {
             let n = n as i64;
-            from_ordered_key(if end < start { start - n } else { start + n })
+            from_ordered_key(if to < from { from - n } else { from + n })
         };
         let ulp = (toward(1) - s.hi).abs();
+        // the shortfall is positive, so `predicted` is ≥ 0, +∞ or NaN; 2⁵² bounds the cast
         let predicted = (required - first.lo()) / (bound.slope(s.hi)?.abs() * ulp);
-        // 2⁵² bounds the cast below; NaN is rejected too
         if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
             return None;
         }
-        let n = (predicted.max(0.0) * 1.125 + 2.0) as u64;
-        if n > end.abs_diff(start) {
+        // below 2⁵³ the conversion through i64 is exact and branch-free
+        let n = (predicted * 1.125 + 2.0) as i64 as u64;
+        if n > from.abs_diff(to) {
             return None;
         }
         let x = toward(n);
@@ -886,12 +901,13 @@ pub fn v_safe_step(
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
     let cc = constants::c(k, sigma)?;
-    let outcome = v_update::safe_step_with_c(cc, grad_v, required)?;
+    let n = inf_norm(grad_v);
+    let outcome = v_update::safe_step_with_norm(cc, n, required)?;
     certify_fast_then_interval(
         outcome,
         required,
-        || squared_parabola(inf_norm(grad_v), rounding::c(k, sigma, cc)),
-        || Quadratic::v_update(k, sigma, grad_v).map(Some),
+        move || squared_parabola(n, rounding::c(k, sigma, cc)),
+        move || Quadratic::v_update(k, sigma, grad_v).map(Some),
     )
 }
 
@@ -916,8 +932,8 @@ pub fn w_safe_step_along_j(
     certify_fast_then_interval(
         outcome,
         required,
-        || squared_parabola(grad_w_j, rounding::d(k, sigma, dd)),
-        || Quadratic::w_along_j(k, sigma, grad_w_j).map(Some),
+        move || squared_parabola(grad_w_j, rounding::d(k, sigma, dd)),
+        move || Quadratic::w_along_j(k, sigma, grad_w_j).map(Some),
     )
 }
 
@@ -942,12 +958,12 @@ pub fn w_safe_step_along_l(
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
     let outcome = w_update::safe_step_along_l_with_d(dd, grad_w_j, grad_w_l, required)?;
-    let fast = || {
+    let fast = move || {
         let (j, l) = (Rounded::exact(grad_w_j), Rounded::exact(grad_w_l));
         let b = rounding::d(k, sigma, dd)?.mul(l.mul(l)?)?;
         Some(RoundedBound::parabola(l.mul(j)?, b))
     };
-    certify_fast_then_interval(outcome, required, fast, || {
+    certify_fast_then_interval(outcome, required, fast, move || {
         Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l).map(Some)
     })
 }
@@ -977,8 +993,8 @@ pub fn hp_v_safe_step(
     certify_fast_then_interval(
         outcome,
         required,
-        || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form),
-        || HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form),
+        move || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form),
+        move || HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form),
     )
 }
 
@@ -999,15 +1015,17 @@ pub fn hp_w_safe_step_along_j(
     required: f64,
     form: HpForm,
 ) -> Result<Certified, BoundsError> {
-    let outcome = hp::w_safe_step_along_j(k, sigma, grad_w_j_hat, eps, required, form)?;
+    finite("required", required)?;
+    let dd = constants::d(k, sigma)?;
+    let outcome = match hp::HighProbabilityBound::w_along_j_with_d(dd, grad_w_j_hat, eps)? {
+        Some(b) => b.safe_step(required, form)?,
+        None => StepOutcome::BelowNoise,
+    };
     certify_fast_then_interval(
         outcome,
         required,
-        || {
-            let dd = rounding::d(k, sigma, constants::d(k, sigma).ok()?);
-            corrected_parabola(grad_w_j_hat.abs(), eps, dd, form)
-        },
-        || HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form),
+        move || corrected_parabola(grad_w_j_hat.abs(), eps, rounding::d(k, sigma, dd), form),
+        move || HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form),
     )
 }
 
@@ -1031,13 +1049,17 @@ pub fn hp_w_safe_step_along_l(
 ) -> Result<Certified, BoundsError> {
     let (j, ej) = grad_w_j_hat;
     let (l, el) = grad_w_l_hat;
-    let outcome = hp::w_safe_step_along_l(k, sigma, j, ej, l, el, required, form)?;
-    let fast = || {
+    finite("required", required)?;
+    let dd = constants::d(k, sigma)?;
+    let outcome = match hp::HighProbabilityBound::w_along_l_with_d(dd, j, ej, l, el)? {
+        Some(b) => b.safe_step(required, form)?,
+        None => StepOutcome::BelowNoise,
+    };
+    let fast = move || {
         let (nj, nl) = (j.abs(), l.abs());
         let (l_hi, j_hi) = (Rounded::sum(nl, el), Rounded::sum(nj, ej));
         let lower = Rounded::difference(nl, el).mul(Rounded::difference(nj, ej))?;
-        let dd = rounding::d(k, sigma, constants::d(k, sigma).ok()?)?;
-        let b = dd.mul(l_hi.mul(l_hi)?)?;
+        let b = rounding::d(k, sigma, dd)?.mul(l_hi.mul(l_hi)?)?;
         let direction = if (j > 0.0) == (l > 0.0) { 1.0 } else { -1.0 };
         Some(RoundedBound::high_probability(
             direction,
@@ -1047,7 +1069,7 @@ pub fn hp_w_safe_step_along_l(
             form,
         ))
     };
-    certify_fast_then_interval(outcome, required, fast, || {
+    certify_fast_then_interval(outcome, required, fast, move || {
         HpEnclosure::w_along_l(k, sigma, grad_w_j_hat, grad_w_l_hat, form)
     })
 }
@@ -1178,7 +1200,7 @@ pub fn exploring_safe_step(
 ) -> Result<Certified, BoundsError> {
     let bound = ExploringBound::new(k, sigma, grad_w_j_hat, eps_j)?;
     let outcome = bound.step_along(grad_w_l_hat, required)?;
-    let fast = || {
+    let fast = move || {
         // in β (Δw = β·l): a = l·(j − sign(l)·ε) for β ≥ 0, l·(j + sign(l)·ε) for β < 0,
         // b = d·l²
         let l = Rounded::exact(grad_w_l_hat);
@@ -1192,12 +1214,9 @@ pub fn exploring_safe_step(
             (against, toward)
         };
         let b = rounding::d(k, sigma, bound.d)?.mul(l.mul(l)?)?;
-        Some(RoundedBound::two_sided(
-            Parabola::new(l.mul(pos)?, b),
-            Parabola::new(l.mul(neg)?, b),
-        ))
+        Some(RoundedBound::two_sided(l.mul(pos)?, l.mul(neg)?, b))
     };
-    certify_fast_then_interval(outcome, required, fast, || {
+    certify_fast_then_interval(outcome, required, fast, move || {
         ExploringEnclosure::new(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat).map(Some)
     })
 }

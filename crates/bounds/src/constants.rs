@@ -21,6 +21,9 @@ pub struct TaskConstants {
     m_phi: f64,
     action_volume: f64,
     psi: Option<f64>,
+    /// Whether R, M_φ, |A| and γ lie in the range of the rounding analysis of c and d
+    /// (`crate::rounding`), decided once here.
+    rounding_box: bool,
 }
 
 impl TaskConstants {
@@ -49,12 +52,18 @@ impl TaskConstants {
                 domain: "[0, 1)",
             });
         }
+        let (r_max, m_phi, action_volume) = (
+            positive("r_max", r_max)?,
+            positive("m_phi", m_phi)?,
+            positive("action_volume", action_volume)?,
+        );
         Ok(Self {
             gamma,
-            r_max: positive("r_max", r_max)?,
-            m_phi: positive("m_phi", m_phi)?,
-            action_volume: positive("action_volume", action_volume)?,
+            r_max,
+            m_phi,
+            action_volume,
             psi: None,
+            rounding_box: crate::rounding::task_in_box(gamma, r_max, m_phi, action_volume),
         })
     }
 
@@ -82,6 +91,12 @@ impl TaskConstants {
     /// The ψ that replaces Lemma A.1's value, if any ([`TaskConstants::with_psi`]).
     pub fn psi_override(&self) -> Option<f64> {
         self.psi
+    }
+
+    /// Whether R, M_φ, |A| and γ lie in the range of the rounding analysis (`crate::rounding`).
+    #[inline]
+    pub(crate) fn in_rounding_box(&self) -> bool {
+        self.rounding_box
     }
 
     /// The ψ that d (Theorem 4.3) uses: the override, or Lemma A.1's [`psi()`].

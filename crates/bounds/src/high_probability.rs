@@ -146,7 +146,15 @@ impl HighProbabilityBound {
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        let dd = d(k, sigma)?;
+        Self::w_along_j_with_d(d(k, sigma)?, grad_w_j_hat, eps)
+    }
+
+    /// [`Self::w_along_j`] for a given d(σ).
+    pub(crate) fn w_along_j_with_d(
+        dd: f64,
+        grad_w_j_hat: f64,
+        eps: f64,
+    ) -> Result<Option<Self>, BoundsError> {
         let Some(n) = corrected_norm(&[grad_w_j_hat], eps)? else {
             return Ok(None);
         };
@@ -180,7 +188,17 @@ impl HighProbabilityBound {
         grad_w_l_hat: f64,
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        let dd = d(k, sigma)?;
+        Self::w_along_l_with_d(d(k, sigma)?, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)
+    }
+
+    /// [`Self::w_along_l`] for a given d(σ).
+    pub(crate) fn w_along_l_with_d(
+        dd: f64,
+        grad_w_j_hat: f64,
+        eps_j: f64,
+        grad_w_l_hat: f64,
+        eps_l: f64,
+    ) -> Result<Option<Self>, BoundsError> {
         let nj = corrected_norm(&[grad_w_j_hat], eps_j)?;
         let nl = corrected_norm(&[grad_w_l_hat], eps_l)?;
         let (Some(nj), Some(nl)) = (nj, nl) else {

@@ -28,10 +28,11 @@
 //!
 //!   Both counts need every intermediate result to be a normal number: that holds when R,
 //!   M_φ, |A| and σ lie in [2⁻¹⁰⁰, 2¹⁰⁰] and γ = 0 or γ ≥ 2⁻¹⁰⁰ (every intermediate then lies
-//!   within 2^±810), which [`apriori_box`] checks; outside it the interval path is used.
+//!   within 2^±810), which [`apriori_box`] checks (the part on R, M_φ, |A|, γ once, when the
+//!   [`TaskConstants`] are built: [`task_in_box`]); outside it the interval path is used.
 //! - Further products are checked one at a time: a product whose result is normal obeys the
 //!   model ([`Rounded::mul`] returns `None` otherwise).
-//! - **The parabola at an exact x** ([`Parabola::enclose`]). With â = a(1 + θ_a),
+//! - **The parabola at an exact x** ([`RoundedBound::enclose`]). With â = a(1 + θ_a),
 //!   b̂ = b(1 + θ_b), |θ| ≤ γ_k, compute t₁ = fl(x·â), t₂ = fl(fl(x·x)·b̂), r = fl(t₁ − t₂).
 //!   When fl(x·x) is normal, t₁ = x·a(1 + θ_{k+1}) + η₁ and t₂ = x²b(1 + θ_{k+2}) + η₂ with
 //!   |ηᵢ| ≤ 2⁻¹⁰⁷⁵ (underflow of the products), so |x·a − t₁| ≤ (k+2)u|t₁| + 2η,
@@ -43,8 +44,13 @@
 //!   (1 − u)²·31 ≥ 4, [fl(r − e), fl(r + e)] encloses p(x): the three extra units of u absorb
 //!   the roundings of e and of its end points, the added 2⁻¹⁰⁷⁰ the underflow terms.
 //!
-//! When fl(x·x) is not normal, or anything overflows, the same parabola is evaluated in
-//! interval arithmetic with its coefficients widened by (k+4)u ([`Parabola::widened`]).
+//! A [`RoundedBound`] has one b and a linear coefficient for each side of 0; k is the largest
+//! count of the three. Two comparisons select the case above: fl(x·x) ≥ 2⁻¹⁰²² (a
+//! non-negative square is normal unless below that or infinite) and e ≤ `f64::MAX` (an infinite
+//! fl(x·x), t₁ or t₂ makes e infinite or NaN, which fails the comparison, and a finite e bounds
+//! |r| ≤ fl(|t₁| + |t₂|)). When they fail (x = 0, fl(x·x) not normal, an overflow), the same
+//! parabola is evaluated in interval arithmetic with its coefficients widened by (k+4)u
+//! ([`RoundedBound::widened`]).
 //! The exact-arithmetic campaign (`verification/src/campaign`) checks every enclosure of both
 //! paths against a 256-bit evaluation from independent formulas.
 
@@ -61,20 +67,30 @@ const U: f64 = f64::EPSILON / 2.0;
 const C_ROUNDINGS: u32 = 14;
 /// Roundings of [`constants::d`] (module docs).
 const D_ROUNDINGS: u32 = 12;
-/// 2⁻¹⁰⁷⁰: covers the underflow terms of [`Parabola::enclose`] (module docs).
+/// 2⁻¹⁰⁷⁰: covers the underflow terms of [`RoundedBound::enclose`] (module docs).
 const UNDERFLOW_SLACK: f64 = 16.0 * f64::from_bits(1);
 /// The range [2⁻¹⁰⁰, 2¹⁰⁰] in which the task constants and σ keep c and d normal.
 const BOX_LO: f64 = 7.888_609_052_210_118e-31;
 const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
 
+/// Whether R, M_φ, |A| ∈ [2⁻¹⁰⁰, 2¹⁰⁰], γ = 0 or γ ≥ 2⁻¹⁰⁰, and the platform's ψ lies within
+/// one ulp of its enclosure (decided once, when the [`TaskConstants`] are built; the last
+/// condition only matters for d, and holds wherever `exp` is accurate to an ulp).
+pub(crate) fn task_in_box(gamma: f64, r_max: f64, m_phi: f64, action_volume: f64) -> bool {
+    let inside = |x: f64| (BOX_LO..=BOX_HI).contains(&x);
+    inside(r_max)
+        && inside(m_phi)
+        && inside(action_volume)
+        && (gamma == 0.0 || gamma >= BOX_LO)
+        && psi_is_enclosed()
+}
+
 /// Whether the roundings counted for c(σ) and d(σ) hold: R, M_φ, |A|, σ ∈ [2⁻¹⁰⁰, 2¹⁰⁰] and
-/// γ = 0 or γ ≥ 2⁻¹⁰⁰, so that no intermediate result underflows or overflows.
+/// γ = 0 or γ ≥ 2⁻¹⁰⁰, so that no intermediate result underflows or overflows, and the
+/// platform's ψ is enclosed ([`task_in_box`]).
 #[inline]
 fn apriori_box(k: &TaskConstants, sigma: f64) -> bool {
-    // all four are positive (validated), so min and max decide
-    let smallest = k.r_max().min(k.m_phi()).min(k.action_volume()).min(sigma);
-    let largest = k.r_max().max(k.m_phi()).max(k.action_volume()).max(sigma);
-    smallest >= BOX_LO && largest <= BOX_HI && (k.gamma() == 0.0 || k.gamma() >= BOX_LO)
+    k.in_rounding_box() && (BOX_LO..=BOX_HI).contains(&sigma)
 }
 
 /// Whether the platform's `f64` ψ ([`constants::psi`], which calls `exp`) lies within one ulp
@@ -122,14 +138,17 @@ impl Rounded {
     /// The product, or `None` when it underflows or overflows (the model would not hold). A
     /// zero factor gives the exact zero.
     pub(crate) fn mul(self, o: Self) -> Option<Self> {
-        if self.value == 0.0 || o.value == 0.0 {
-            return Some(Self::exact(0.0));
-        }
         let value = self.value * o.value;
-        value.is_normal().then_some(Self {
-            value,
-            roundings: self.roundings + o.roundings + 1,
-        })
+        if (f64::MIN_POSITIVE..=f64::MAX).contains(&value.abs()) {
+            Some(Self {
+                value,
+                roundings: self.roundings + o.roundings + 1,
+            })
+        } else if self.value == 0.0 || o.value == 0.0 {
+            Some(Self::exact(0.0))
+        } else {
+            None
+        }
     }
 
     /// The exact negation.
@@ -152,87 +171,48 @@ pub(crate) fn c(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
 }
 
 /// d(σ) with its 12 roundings, from `value` = [`constants::d`]`(k, sigma)`; `None` outside
-/// [`apriori_box`] or when the platform's ψ is not within one ulp of its enclosure.
+/// [`apriori_box`] (which includes the check that the platform's ψ is within one ulp of its
+/// enclosure).
 #[inline]
 pub(crate) fn d(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
-    (apriori_box(k, sigma) && psi_is_enclosed()).then_some(Rounded {
+    apriori_box(k, sigma).then_some(Rounded {
         value,
         roundings: D_ROUNDINGS,
     })
 }
 
-/// p(x) = a·x − b·x² with `f64` coefficients of at most k roundings (module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Parabola {
-    a: f64,
-    b: f64,
-    /// (k + 7)·u: the relative error factor of [`Self::enclose`].
-    margin: f64,
-    /// (k + 4)·u: the relative widening of [`Self::widened`].
-    widening: f64,
-}
-
-impl Parabola {
-    pub(crate) fn new(a: Rounded, b: Rounded) -> Self {
-        let k = f64::from(a.roundings.max(b.roundings));
-        Self {
-            a: a.value,
-            b: b.value,
-            margin: (k + 7.0) * U,
-            widening: (k + 4.0) * U,
-        }
-    }
-
-    /// An enclosure of p(x) at the exact x (module docs).
-    #[inline]
-    pub(crate) fn enclose(&self, x: f64) -> Interval {
-        if x == 0.0 {
-            return Interval::point(0.0);
-        }
-        let xx = x * x;
-        let t1 = x * self.a;
-        let t2 = xx * self.b;
-        let r = t1 - t2;
-        let e = (t1.abs() + t2.abs()) * self.margin + UNDERFLOW_SLACK;
-        if xx.is_normal() && r.is_finite() && e.is_finite() {
-            Interval::from_sorted(r - e, r + e)
-        } else {
-            self.widened().enclose(x)
-        }
-    }
-
-    /// The parabola with interval coefficients that contain the exact a and b: each
-    /// coefficient v̂ of k roundings is within |v̂|·γ_k/(1 − γ_k) ≤ (k+1)u|v̂| of v, and the
-    /// widening by (k+4)u, rounded outward, covers that and its own rounding.
-    pub(crate) fn widened(&self) -> Quadratic {
-        let widen = |v: f64| Interval::around(v, v.abs() * self.widening);
-        Quadratic {
-            linear: widen(self.a),
-            quadratic: widen(self.b),
-        }
-    }
-
-    fn slope(&self, x: f64) -> f64 {
-        self.a - 2.0 * self.b * x
-    }
-}
-
-/// A bound that is one parabola for x ≥ 0 and another for x < 0 (both through the origin),
-/// enclosed with a-priori error bounds: the fast [`EnclosedBound`] of the certified steps.
+/// A bound that is the parabola p(x) = a₊·x − b·x² for x ≥ 0 and a₋·x − b·x² for x < 0 (one
+/// quadratic coefficient, both through the origin), with `f64` coefficients of at most k
+/// roundings, enclosed with a-priori error bounds (module docs): the fast [`EnclosedBound`] of
+/// the certified steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct RoundedBound {
-    positive: Parabola,
-    negative: Parabola,
+    /// a₊, the linear coefficient for x ≥ 0.
+    positive: f64,
+    /// a₋, the linear coefficient for x < 0.
+    negative: f64,
+    /// b.
+    b: f64,
+    /// (k + 7)·u for the largest k of the three coefficients: the relative error factor of
+    /// [`Self::enclose`].
+    margin: f64,
 }
 
 impl RoundedBound {
+    /// Separate linear coefficients for x ≥ 0 and x < 0 (the exploring w-update).
+    pub(crate) fn two_sided(positive: Rounded, negative: Rounded, b: Rounded) -> Self {
+        let k = positive.roundings.max(negative.roundings).max(b.roundings);
+        Self {
+            positive: positive.value,
+            negative: negative.value,
+            b: b.value,
+            margin: f64::from(k + 7) * U,
+        }
+    }
+
     /// One parabola on both sides (Theorems 4.2, 4.3, 4.5).
     pub(crate) fn parabola(a: Rounded, b: Rounded) -> Self {
-        let p = Parabola::new(a, b);
-        Self {
-            positive: p,
-            negative: p,
-        }
+        Self::two_sided(a, a, b)
     }
 
     /// The high-probability bounds of Theorems 4.7–4.9: direction s = ±1, corrected linear
@@ -246,47 +226,70 @@ impl RoundedBound {
         form: HpForm,
     ) -> Self {
         let other = if form == HpForm::Thesis { lower } else { upper };
-        let signed = |a: Rounded| if direction > 0.0 { a } else { a.neg() };
-        let (favoured, other) = (
-            Parabola::new(signed(lower), b),
-            Parabola::new(signed(other), b),
-        );
         if direction > 0.0 {
-            Self {
-                positive: favoured,
-                negative: other,
-            }
+            Self::two_sided(lower, other, b)
         } else {
-            Self {
-                positive: other,
-                negative: favoured,
-            }
+            Self::two_sided(other.neg(), lower.neg(), b)
         }
     }
 
-    /// Separate parabolas for x ≥ 0 and x < 0 (the exploring w-update).
-    pub(crate) fn two_sided(positive: Parabola, negative: Parabola) -> Self {
-        Self { positive, negative }
+    /// The linear coefficient on the side of x.
+    #[inline(always)]
+    fn linear(&self, x: f64) -> f64 {
+        if x >= 0.0 {
+            self.positive
+        } else {
+            self.negative
+        }
     }
 
-    #[inline]
-    fn side(&self, x: f64) -> &Parabola {
-        if x >= 0.0 {
-            &self.positive
+    /// The parabola of the side of x with interval coefficients that contain the exact a and
+    /// b: each coefficient v̂ of k roundings is within |v̂|·γ_k/(1 − γ_k) ≤ (k+1)u|v̂| of v,
+    /// and the widening by (k+4)u = margin − 3u, rounded outward, covers that and its own
+    /// rounding.
+    pub(crate) fn widened(&self, x: f64) -> Quadratic {
+        let widening = self.margin - 3.0 * U;
+        let widen = |v: f64| Interval::around(v, v.abs() * widening);
+        Quadratic {
+            linear: widen(self.linear(x)),
+            quadratic: widen(self.b),
+        }
+    }
+
+    /// The rare cases of [`Self::enclose`]: p(0) = 0, and the widened interval evaluation.
+    #[cold]
+    #[inline(never)]
+    fn enclose_widened(&self, x: f64) -> Interval {
+        if x == 0.0 {
+            Interval::point(0.0)
         } else {
-            &self.negative
+            self.widened(x).enclose(x)
         }
     }
 }
 
 impl EnclosedBound for RoundedBound {
-    #[inline]
+    /// An enclosure of p(x) at the exact x (module docs).
+    #[inline(always)]
     fn enclose(&self, x: f64) -> Interval {
-        self.side(x).enclose(x)
+        let xx = x * x;
+        let t1 = x * self.linear(x);
+        let t2 = xx * self.b;
+        let r = t1 - t2;
+        let e = (t1.abs() + t2.abs()) * self.margin + UNDERFLOW_SLACK;
+        // two comparisons decide the common case: xx ≥ 0 is normal unless below
+        // MIN_POSITIVE or infinite, and an infinite xx, t₁ or t₂ makes e infinite or NaN
+        // (NaN fails the comparison); a finite e bounds |r| ≤ fl(|t₁| + |t₂|)
+        if xx >= f64::MIN_POSITIVE && e <= f64::MAX {
+            Interval::from_sorted(r - e, r + e)
+        } else {
+            self.enclose_widened(x)
+        }
     }
 
+    #[inline(always)]
     fn slope(&self, x: f64) -> Option<f64> {
-        Some(self.side(x).slope(x))
+        Some(self.linear(x) - 2.0 * self.b * x)
     }
 }
 
@@ -320,10 +323,10 @@ mod tests {
 
     #[test]
     fn subnormal_steps_fall_back_to_the_widened_interval() {
-        let p = Parabola::new(Rounded::exact(1.0), Rounded::exact(1.0));
+        let p = RoundedBound::parabola(Rounded::exact(1.0), Rounded::exact(1.0));
         // x² underflows: the interval evaluation of the widened coefficients is used
         let x = 1e-170;
-        assert_eq!(p.enclose(x), p.widened().enclose(x));
+        assert_eq!(p.enclose(x), p.widened(x).enclose(x));
         assert!(p.enclose(x).contains(x));
         // a normal step uses the error bound, whose width is about 2(k+7)u|x|
         let e = p.enclose(0.5);

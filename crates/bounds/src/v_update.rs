@@ -135,7 +135,16 @@ pub(crate) fn safe_step_with_c(
     grad_v: &[f64],
     required: f64,
 ) -> Result<StepOutcome, BoundsError> {
-    let n = inf_norm(grad_v);
+    safe_step_with_norm(cc, inf_norm(grad_v), required)
+}
+
+/// [`safe_step_with_c`] for the norm n = ‖∇_vJ‖∞ of a validated gradient.
+#[inline]
+pub(crate) fn safe_step_with_norm(
+    cc: f64,
+    n: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
     let n2 = no_overflow("||grad_v||^2", n * n)?;
     solve_quadratic(n2, cc * n2, required)
 }

@@ -293,6 +293,10 @@ pub struct Summary {
     /// older summaries, which always used the raw action).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scores: Option<ScoresName>,
+    /// Whether the SEPG variants took certified safe steps (absent for the comparison
+    /// algorithms, and from the summaries of older versions, which always did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certified_steps: Option<bool>,
 }
 
 /// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).

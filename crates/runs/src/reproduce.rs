@@ -203,6 +203,9 @@ pub struct OptionFlags {
     /// Policy scores at the raw or at the clipped action [default: raw].
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     pub scores: Option<ScoresName>,
+    /// Certified safe steps of the SEPG variants [default: true].
+    #[cfg_attr(feature = "clap", arg(long = "certified-steps"))]
+    pub certified_steps: Option<bool>,
 }
 
 impl OptionFlags {
@@ -226,7 +229,8 @@ impl OptionFlags {
             m_phi,
             action_volume,
             psi,
-            scores
+            scores,
+            certified_steps
         )
     }
 
@@ -254,6 +258,7 @@ impl OptionFlags {
             action_volume: self.action_volume,
             psi: self.psi,
             scores: self.scores,
+            certified_steps: self.certified_steps.filter(|_| sepg),
             ..RunSpec::default()
         }
     }

@@ -285,6 +285,7 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
             }
         },
         scores: resolved.spec.scores,
+        certified_steps: resolved.spec.certified_steps,
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     Ok(summary)

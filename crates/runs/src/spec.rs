@@ -499,6 +499,12 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub scores: Option<ScoresName>,
+    /// Certified safe steps (SEPG variants): each step's bound, evaluated in outward-rounded
+    /// interval arithmetic with the inputs taken as exact, meets its requirement; false takes
+    /// the largest safe steps as computed in f64 [default: true].
+    #[cfg_attr(feature = "clap", arg(long = "certified-steps"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certified_steps: Option<bool>,
 }
 
 macro_rules! overlay_fields {
@@ -515,7 +521,7 @@ impl RunSpec {
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
             estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
             metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
-            reference_batch, gamma, r_max, m_phi, action_volume, psi, scores)
+            reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -574,9 +580,11 @@ impl RunSpec {
                 .scores
                 .map_or(ScoreAction::Raw, ScoresName::score_action),
         };
+        let certified_steps = algo.is_sepg().then(|| self.certified_steps.unwrap_or(true));
         let checked = config
             .check()
-            .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+            .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?
+            .with_certified_steps(certified_steps.unwrap_or(true));
         let spec = RunSpec {
             name: Some(self.name.clone().unwrap_or_else(|| algo.name().to_owned())),
             env: Some(env_name),
@@ -590,6 +598,7 @@ impl RunSpec {
             ),
             scores: (gradients == GradientsName::Sampled)
                 .then_some(self.scores.unwrap_or(ScoresName::Raw)),
+            certified_steps,
             ..RunSpec::resolved_values(&method, &sampling, start, &schedule, options.as_ref())
         };
         Ok(Resolved {
@@ -635,6 +644,11 @@ impl RunSpec {
                     || self.quantile_factor.is_some()),
             "w-step/w-direction/metagradient-clip/lb1-requirement/alternating/\
              reference-batch/confidence/quantile-factor",
+            &for_algo,
+        )?;
+        reject(
+            !sepg && self.certified_steps.is_some(),
+            "certified-steps",
             &for_algo,
         )?;
         let naive = algo == AlgoName::SepgNaiveW;

@@ -694,10 +694,24 @@ fn run_cases(cases: impl Iterator<Item = (u64, Case)>) -> Vec<FormTally> {
 /// assert!(tallies.iter().all(|t| t.clean() && t.cases == 64));
 /// ```
 pub fn run(config: &CampaignConfig) -> Vec<FormTally> {
-    let chunks = config.random.div_ceil(CHUNK);
-    let seed = config.seed;
     let total = config.random;
-    let mut parts: Vec<Vec<FormTally>> = (0..chunks)
+    let mut parts = vec![run_random(config.seed, total, 0..total.div_ceil(CHUNK))];
+    if config.adversarial {
+        parts.push(run_adversarial(total));
+    }
+    let mut out = empty();
+    for part in parts {
+        merge(&mut out, part);
+    }
+    out
+}
+
+/// The random configurations of the chunks `chunks` (of 256) out of `total`, tallied in
+/// parallel: [`run`] without the adversarial grid is `run_random(seed, total, 0..⌈total/256⌉)`,
+/// and tallies of consecutive ranges [`merge`]d in order equal those of the whole range, so a
+/// long campaign can report its progress.
+pub fn run_random(seed: u64, total: u64, chunks: std::ops::Range<u64>) -> Vec<FormTally> {
+    let parts: Vec<Vec<FormTally>> = chunks
         .into_par_iter()
         .map(|chunk| {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(splitmix64(seed ^ splitmix64(chunk)));
@@ -706,28 +720,39 @@ pub fn run(config: &CampaignConfig) -> Vec<FormTally> {
             run_cases((start..end).map(|i| (i, random_case(&mut rng))))
         })
         .collect();
-    if config.adversarial {
-        let cases = adversarial_cases();
-        parts.extend(
-            cases
-                .par_chunks(64)
-                .enumerate()
-                .map(|(chunk, cs)| {
-                    let base = total + (chunk * 64) as u64;
-                    run_cases(
-                        cs.iter()
-                            .enumerate()
-                            .map(|(i, c)| (base + i as u64, c.clone())),
-                    )
-                })
-                .collect::<Vec<_>>(),
-        );
-    }
     let mut out = empty();
     for part in parts {
-        for (t, p) in out.iter_mut().zip(part) {
-            t.merge(p);
-        }
+        merge(&mut out, part);
+    }
+    out
+}
+
+/// Adds the tallies `part` (of later configurations) to `into`, form by form.
+pub fn merge(into: &mut [FormTally], part: Vec<FormTally>) {
+    for (t, p) in into.iter_mut().zip(part) {
+        t.merge(p);
+    }
+}
+
+/// The tallies of the fixed adversarial grid alone, numbered after `random` random
+/// configurations ([`run`] adds them when `adversarial` is set).
+pub fn run_adversarial(random: u64) -> Vec<FormTally> {
+    let cases = adversarial_cases();
+    let parts: Vec<Vec<FormTally>> = cases
+        .par_chunks(64)
+        .enumerate()
+        .map(|(chunk, cs)| {
+            let base = random + (chunk * 64) as u64;
+            run_cases(
+                cs.iter()
+                    .enumerate()
+                    .map(|(i, c)| (base + i as u64, c.clone())),
+            )
+        })
+        .collect();
+    let mut out = empty();
+    for part in parts {
+        merge(&mut out, part);
     }
     out
 }

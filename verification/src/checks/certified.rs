@@ -1,6 +1,6 @@
 //! Certified safe steps (`sepg_bounds::certified`) against exact arithmetic.
 
-use crate::campaign::{CampaignConfig, run};
+use crate::campaign::{CampaignConfig, FORMS, adversarial_len, run};
 use crate::check::{
     Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Outcome, Tolerance,
 };
@@ -63,8 +63,9 @@ fn certified_steps(ctx: &CheckContext<'_>) -> Evaluation {
 pub(crate) fn checks() -> Vec<Check> {
     let meta = CheckMeta {
         id: "certified-steps-exact".into(),
-        statement: "Certified safe steps (Theorems 4.2, 4.3, 4.5, 4.7–4.9 and the rigorous \
-                    w-bound, evaluated in interval arithmetic)"
+        statement: "Certified safe steps (Theorems 4.2, 4.3, 4.5, 4.7–4.9, the rigorous \
+                    w-bound, the exploring w-update and the adaptive step's guarantee, \
+                    evaluated in interval arithmetic)"
             .into(),
         location: "Theorems 4.2–4.9, eqs. (4.8)–(4.30); docs/THEOREMS.md, Certified steps".into(),
         claim: "Every step returned as certified satisfies B(step) ≥ C in exact real \
@@ -76,11 +77,15 @@ pub(crate) fn checks() -> Vec<Check> {
                        rigorous remainders), bound formulas written independently of \
                        sepg-bounds"
             .into(),
-        sampling: "random configurations (γ, R, M_φ, |A| log-uniform, σ ∈ [1e-10, 1e6], \
-                   gradients of both signs from subnormal to 1e150, C = C_max(1 − k·2⁻⁵²), \
-                   C_max/2, 0, −C_max, −10·C_max) plus a fixed adversarial grid of 1,440; \
-                   each in 11 bound forms"
-            .into(),
+        sampling: format!(
+            "random configurations (γ, R, M_φ, |A| log-uniform, σ ∈ [1e-10, 1e6], gradients \
+             of both signs from subnormal to 1e150, C = C_max(1 − k·2⁻⁵²), C_max/2, 0, \
+             −C_max, −10·C_max) plus a fixed adversarial grid of {}; each in {} bound forms \
+             ({})",
+            adversarial_len(),
+            FORMS.len(),
+            FORMS.join(", ")
+        ),
         kind: ClaimKind::LowerBound,
         cases_full: 20_000,
         cases_quick: 256,
