@@ -2,7 +2,7 @@
 //! determinism across thread counts, and the bad-input contract.
 
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use rand::{Rng, SeedableRng};
@@ -95,7 +95,7 @@ fn the_readme_example_writes_a_complete_run_folder() {
     assert_eq!(s["status"], "complete");
     assert_eq!(s["iterations"], 30);
     let vs = s["v_star"][0].as_f64().expect("v*");
-    assert!((vs - v_star()).abs() < 1e-12, "{vs}");
+    approx::assert_abs_diff_eq!(vs, v_star(), epsilon = 1e-12);
     let v = s["final"]["v"][0].as_f64().expect("v");
     assert_eq!(s["abs_v_error"].as_f64(), Some((v - vs).abs()));
     let ck = json(&dir.join("checkpoint.json"));
@@ -154,17 +154,37 @@ fn partial_state(dir: &Path) -> (u64, usize) {
     (iteration, bytes)
 }
 
-/// After a kill, the folder is consistent: no `log.csv` or `summary.json`, and the first
-/// `log_bytes` bytes of the partial log hold exactly the checkpoint's iterations.
-fn assert_consistent_after_kill(dir: &Path) {
-    assert!(
-        !dir.join("log.csv").exists(),
-        "a killed run must not leave a log.csv"
-    );
-    assert!(!dir.join("summary.json").exists());
+/// The folder of a run killed at any instant is one of three (the module documentation of
+/// `sepg_runs::run`), checked against the uninterrupted run `reference`:
+/// - `summary.json`: complete, and the same run as `reference`;
+/// - `log.csv` without `summary.json` (killed between the final rename and the summary): no
+///   partial log, the checkpoint holds the last iteration and vouches for the whole log, which
+///   is the reference's;
+/// - neither: the first `log_bytes` bytes of `log.partial.csv` are the reference log's first
+///   bytes and hold exactly the checkpoint's iterations.
+///
+/// Returns whether the run is incomplete (something is left to resume).
+fn assert_consistent_after_kill(dir: &Path, reference: &Path) -> bool {
+    if dir.join("summary.json").exists() {
+        assert!(!dir.join("log.partial.csv").exists());
+        assert_same_run(reference, dir);
+        return false;
+    }
     let (iteration, bytes) = partial_state(dir);
+    let whole = std::fs::read(reference.join("log.csv")).expect("reference log");
+    if dir.join("log.csv").exists() {
+        assert!(!dir.join("log.partial.csv").exists());
+        assert_eq!(
+            iteration,
+            json(&reference.join("summary.json"))["iterations"]
+        );
+        assert_eq!(bytes, whole.len());
+        assert_eq!(std::fs::read(dir.join("log.csv")).expect("log"), whole);
+        return true;
+    }
     let partial = std::fs::read(dir.join("log.partial.csv")).expect("partial log");
     assert!(partial.len() >= bytes);
+    assert_eq!(partial[..bytes], whole[..bytes]);
     let text = String::from_utf8(partial[..bytes].to_vec()).expect("utf-8");
     let rows: Vec<&str> = text.lines().skip(1).collect();
     assert_eq!(rows.len() as u64, iteration);
@@ -173,6 +193,22 @@ fn assert_consistent_after_kill(dir: &Path) {
             last.split(',').next(),
             Some((iteration - 1).to_string().as_str())
         );
+    }
+    true
+}
+
+/// Polls the checkpoint of the run `child` writes to `dir` until it holds iteration `k` or
+/// later, or the run has exited.
+fn wait_for_checkpoint(child: &mut Child, dir: &Path, k: u64) {
+    while child.try_wait().expect("wait").is_none() {
+        let done = std::fs::read_to_string(dir.join("checkpoint.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .and_then(|ck| ck["state"]["iteration"].as_u64());
+        if done.is_some_and(|i| i >= k) {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(1));
     }
 }
 
@@ -200,55 +236,58 @@ fn resume(dir: &Path) {
     );
 }
 
+/// SIGKILL at seeded random points of the run, located by its progress (the checkpointed
+/// iteration), not by the clock: each kill lands shortly after a drawn checkpoint, wherever the
+/// writer then is, and the last attempt waits for the final checkpoint so that its kill lands
+/// around the end of the run (the final rename and the summary). Whatever the instant, the
+/// folder must be one of the three a kill may leave, and resume to the uninterrupted run.
+/// Every step between two writes is covered deterministically by
+/// `sepg_runs::run::tests::a_run_killed_after_any_write_resumes_to_the_uninterrupted_run`.
 #[test]
 fn resuming_after_sigkill_at_random_points_is_bit_identical() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let iterations = 1500;
-    let reference = tmp.path().join("reference");
-    let start = Instant::now();
-    sepg_ok(
-        &[
-            readme_run(&reference, iterations),
+    let args = |dir: &Path| {
+        [
+            readme_run(dir, iterations),
             vec!["--checkpoint-every".into(), "37".into()],
         ]
-        .concat(),
-    );
-    let full = start.elapsed();
-    // Kill points drawn uniformly over the reference run time (a fixed stream, so the
-    // attempts are the same on every machine up to its speed).
+        .concat()
+    };
+    let reference = tmp.path().join("reference");
+    sepg_ok(&args(&reference));
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
     let mut killed_mid_run = 0;
     for attempt in 0..6 {
         let dir = tmp.path().join(format!("killed-{attempt}"));
-        let args = [
-            readme_run(&dir, iterations),
-            vec!["--checkpoint-every".into(), "37".into()],
-        ]
-        .concat();
         let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
-            .args(&args)
+            .args(args(&dir))
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
             .expect("spawn");
-        std::thread::sleep(full.mul_f64(rng.random_range(0.1..0.9)));
+        // Iterations 0 to 1350: at least 150 iterations are left after the drawn checkpoint.
+        let k = if attempt < 5 {
+            rng.random_range(0..1350)
+        } else {
+            iterations
+        };
+        wait_for_checkpoint(&mut child, &dir, k);
         child.kill().expect("SIGKILL");
         child.wait().expect("wait");
-        if dir.join("summary.json").exists() {
-            continue;
-        }
         if !dir.join("config.toml").exists() {
-            // Killed before the run folder was set up: nothing to resume, start again.
+            // Killed before the run folder was set up: nothing to resume.
             continue;
         }
-        killed_mid_run += 1;
-        assert_consistent_after_kill(&dir);
-        resume(&dir);
-        assert_same_run(&reference, &dir);
+        if assert_consistent_after_kill(&dir, &reference) {
+            killed_mid_run += u32::from(!dir.join("log.csv").exists());
+            resume(&dir);
+            assert_same_run(&reference, &dir);
+        }
     }
     assert!(
         killed_mid_run >= 2,
-        "only {killed_mid_run} kills landed mid-run (reference took {full:?})"
+        "only {killed_mid_run} of 5 kills landed mid-run"
     );
 }
 
@@ -302,7 +341,9 @@ fn signal_checkpoints_and_resumes_bit_identically(signal: &str) {
         err.contains("interrupted") && err.contains("--resume"),
         "{err}"
     );
-    assert_consistent_after_kill(&dir);
+    // SIGINT stops before the end of the run: the log is still partial.
+    assert!(!dir.join("log.csv").exists());
+    assert!(assert_consistent_after_kill(&dir, &reference));
     // SIGINT stops right after an iteration and checkpoints it: the log ends exactly there.
     let (_, bytes) = partial_state(&dir);
     assert_eq!(

@@ -102,9 +102,10 @@ pub fn json_ok(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("stdout is one JSON value")
 }
 
-/// Relative closeness with an absolute floor.
+/// Relative closeness, `rel` in units of the larger magnitude, with an absolute floor of
+/// `rel`·1e-300 (so that two zeros are close).
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
+    approx::relative_eq!(a, b, epsilon = rel * 1e-300, max_relative = rel)
 }
 
 /// The number under `key` of a JSON object, panicking with the object if it is missing.

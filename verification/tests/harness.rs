@@ -3,6 +3,9 @@
 //! against closed forms.
 
 use approx::{assert_abs_diff_eq, relative_eq};
+use sepg_bounds::BoundsError;
+use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::outcome::{SafeInterval, StepOutcome};
 use sepg_verification::finite_mdp::{FiniteMdp, MdpError, TabularPolicy};
 use sepg_verification::stats::{StatsError, clopper_pearson_lower, clopper_pearson_upper};
 use sepg_verification::{BoundFns, Outcome, RunConfig, derive_seed, registry, run_checks};
@@ -185,89 +188,86 @@ fn a_deliberately_broken_bound_is_caught() {
     assert_eq!(run_broken("lemma-a.3-l1-squared", b), ("violated", false));
 }
 
-/// The v-update of Theorem 4.2 with c(σ) replaced by `factor`·c(σ).
-fn scaled_c(
-    k: &sepg_bounds::constants::TaskConstants,
+/// The v-update bound of Theorem 4.2, α‖∇‖²_∞ − α² c(σ) ‖∇‖²_∞, with c(σ) replaced by
+/// `factor`·c(σ).
+fn scaled_c_bound(
+    k: &TaskConstants,
     sigma: f64,
+    grad: &[f64],
+    alpha: f64,
     factor: f64,
-) -> Result<f64, sepg_bounds::BoundsError> {
-    Ok(factor * sepg_bounds::constants::c(k, sigma)?)
+) -> Result<f64, BoundsError> {
+    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+    let c = factor * sepg_bounds::constants::c(k, sigma)?;
+    Ok(alpha * n * n - alpha * alpha * c * n * n)
+}
+
+/// The safe v-step of the bound with c(σ) replaced by `factor`·c(σ). With α = α′/f,
+/// αn² − α²(f c)n² = (α′n² − α′²c n²)/f: its safe interval is the one of c for `factor` times
+/// the requirement, with every step divided by `factor`.
+fn scaled_c_step(
+    k: &TaskConstants,
+    sigma: f64,
+    grad: &[f64],
+    required: f64,
+    factor: f64,
+) -> Result<StepOutcome, BoundsError> {
+    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, factor * required)?;
+    Ok(match out {
+        StepOutcome::Feasible(s) => StepOutcome::Feasible(SafeInterval {
+            c_max: s.c_max / factor,
+            vertex: s.vertex / factor,
+            lo: s.lo / factor,
+            hi: s.hi / factor,
+            ..s
+        }),
+        other => other,
+    })
 }
 
 fn v_bound_c_halved(
-    k: &sepg_bounds::constants::TaskConstants,
+    k: &TaskConstants,
     sigma: f64,
     grad: &[f64],
     alpha: f64,
-) -> Result<f64, sepg_bounds::BoundsError> {
-    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
-    Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 0.5)? * n * n)
+) -> Result<f64, BoundsError> {
+    scaled_c_bound(k, sigma, grad, alpha, 0.5)
 }
 
 fn v_step_c_halved(
-    k: &sepg_bounds::constants::TaskConstants,
+    k: &TaskConstants,
     sigma: f64,
     grad: &[f64],
     required: f64,
-) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
-    // The safe interval of a bound with c/2 is the one of c for half the requirement, with
-    // steps doubled: (2α)n² − (2α)²(c/2)n² = 2(αn² − α²cn²).
-    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 2.0)?;
-    Ok(match out {
-        sepg_bounds::outcome::StepOutcome::Feasible(s) => {
-            sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
-                c_max: 2.0 * s.c_max,
-                vertex: 2.0 * s.vertex,
-                lo: 2.0 * s.lo,
-                hi: 2.0 * s.hi,
-                ..s
-            })
-        }
-        other => other,
-    })
+) -> Result<StepOutcome, BoundsError> {
+    scaled_c_step(k, sigma, grad, required, 0.5)
 }
 
 fn v_bound_c_tiny(
-    k: &sepg_bounds::constants::TaskConstants,
+    k: &TaskConstants,
     sigma: f64,
     grad: &[f64],
     alpha: f64,
-) -> Result<f64, sepg_bounds::BoundsError> {
-    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
-    Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1e-3)? * n * n)
+) -> Result<f64, BoundsError> {
+    scaled_c_bound(k, sigma, grad, alpha, 1e-3)
 }
 
-/// The v-update bound with c/30 (the safe interval of c/30 is the one of c for 30 times the
-/// requirement, with steps times 30).
 fn v_bound_c_30(
-    k: &sepg_bounds::constants::TaskConstants,
+    k: &TaskConstants,
     sigma: f64,
     grad: &[f64],
     alpha: f64,
-) -> Result<f64, sepg_bounds::BoundsError> {
-    let n = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
-    Ok(alpha * n * n - alpha * alpha * scaled_c(k, sigma, 1.0 / 30.0)? * n * n)
+) -> Result<f64, BoundsError> {
+    scaled_c_bound(k, sigma, grad, alpha, 1.0 / 30.0)
 }
 
 fn v_step_c_30(
-    k: &sepg_bounds::constants::TaskConstants,
+    k: &TaskConstants,
     sigma: f64,
     grad: &[f64],
     required: f64,
-) -> Result<sepg_bounds::outcome::StepOutcome, sepg_bounds::BoundsError> {
-    let out = sepg_bounds::v_update::safe_step(k, sigma, grad, required / 30.0)?;
-    Ok(match out {
-        sepg_bounds::outcome::StepOutcome::Feasible(s) => {
-            sepg_bounds::outcome::StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
-                c_max: 30.0 * s.c_max,
-                vertex: 30.0 * s.vertex,
-                lo: 30.0 * s.lo,
-                hi: 30.0 * s.hi,
-                ..s
-            })
-        }
-        other => other,
-    })
+) -> Result<StepOutcome, BoundsError> {
+    scaled_c_step(k, sigma, grad, required, 1.0 / 30.0)
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Environment semantics (docs/CONVENTIONS.md §1) on hand-derived vectors, preset constants and the registry.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use nalgebra::{DMatrix, DVector};
 use sepg_mdp::env::{AnyEnv, EnvError, Environment, LqgEnv, Preset};
 use sepg_mdp::features::FeatureMap;
@@ -28,7 +29,7 @@ fn lqg_step_clips_action_then_rewards_pre_step_state_then_clips_state() {
     let env = LqgEnv::new(LqgModel::lqg1d().with_clipping(false)).unwrap();
     let (next, r, _) = step(&env, &[3.0], &[5.0]);
     assert_eq!(next, vec![8.0]);
-    assert!((r + 30.6).abs() < 1e-12);
+    assert_abs_diff_eq!(r, -30.6, epsilon = 1e-12);
 }
 
 #[test]
@@ -68,8 +69,8 @@ fn lqg_nd_step_matches_hand_computation() {
     );
     let mut next = [0.0; 2];
     noisy.step(&[1.0, -1.0], &[0.0], &mut rng, &mut next);
-    assert!((next[0] - (0.5 + 0.1 * z0)).abs() < 1e-15);
-    assert!((next[1] - (-1.0 + 0.2 * z1)).abs() < 1e-15);
+    assert_abs_diff_eq!(next[0], 0.5 + 0.1 * z0, epsilon = 1e-15);
+    assert_abs_diff_eq!(next[1], -1.0 + 0.2 * z1, epsilon = 1e-15);
 }
 
 #[test]
@@ -80,7 +81,7 @@ fn preset_constants_and_registry() {
         (4.0, 2.0, 4.0, 0.99, 20)
     );
     let c = Preset::Lqg1d.build().constants();
-    assert!((c.r_max - 28.8).abs() < 1e-12);
+    assert_abs_diff_eq!(c.r_max, 28.8, epsilon = 1e-12);
     assert_eq!((c.m_phi, c.action_volume), (4.0, 8.0));
     let mc = Preset::MountainCar.build();
     let c = mc.constants();
@@ -166,7 +167,7 @@ fn reference_mc_step(pos: f64, vel: f64, action: f64) -> (f64, f64, f64, bool) {
 #[test]
 fn mountain_car_hand_derived_transitions() {
     let env = MountainCar::state_bias();
-    let close = |x: f64, y: f64| (x - y).abs() < 1e-12;
+    let close = |x: f64, y: f64| abs_diff_eq!(x, y, epsilon = 1e-12);
 
     // Left wall: pos −1.19, vel −0.07, a = 0: vel = −0.07 − 0.0025·cos(−3.57) ≈ −0.06772,
     // pos ≈ −1.2577 → clipped to −1.2, and vel < 0 there → vel = 0.
@@ -246,9 +247,9 @@ fn features_of_the_environments() {
     let mut phi = vec![0.0; rbf.feature_dim()];
     // At the centre (−0.3, 0) of the 3×3 grid, feature 4 (middle) is exactly 1.
     rbf.features(&[-0.3, 0.0], &mut phi);
-    assert!((phi[4] - 1.0).abs() < 1e-15);
+    assert_abs_diff_eq!(phi[4], 1.0, epsilon = 1e-15);
     // Neighbour at one spacing in position: exp(−½).
-    assert!((phi[1] - (-0.5f64).exp()).abs() < 1e-12);
+    assert_abs_diff_eq!(phi[1], (-0.5f64).exp(), epsilon = 1e-12);
     assert!(MountainCar::new(FeatureMap::Identity { dim: 1 }).is_err());
     let lqg = LqgEnv::thesis();
     let mut phi = [0.0];

@@ -2,6 +2,7 @@
 //! Lyapunov formula, a forward second-moment recursion written here from scratch, fourth-order
 //! central finite differences of `J`, and the published optimum of the presets.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq, relative_eq};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 use proptest::test_runner::{FileFailurePersistence, RngSeed};
@@ -148,21 +149,26 @@ fn scalar_presets_match_the_high_precision_table() {
             .evaluate(&[v], &ex, h)
             .unwrap();
         let (j, djv, djw, dwv) = (num(4), num(5), num(6), num(7));
+        // The derivatives share J's tolerance: 1e-13 in units of max(|J|, 1).
         let tol = 1e-13 * j.abs().max(1.0);
-        assert!((e.j - j).abs() <= tol, "{line}: J = {}", e.j);
         assert!(
-            (e.grad_v[0] - djv).abs() <= tol,
+            relative_eq!(e.j, j, epsilon = 1e-13, max_relative = 1e-13),
+            "{line}: J = {}",
+            e.j
+        );
+        assert!(
+            abs_diff_eq!(e.grad_v[0], djv, epsilon = tol),
             "{line}: dJ/dv = {}",
             e.grad_v[0]
         );
         if let Exploration::Gaussian { .. } = ex {
             assert!(
-                (e.grad_w[0] - djw).abs() <= tol,
+                abs_diff_eq!(e.grad_w[0], djw, epsilon = tol),
                 "{line}: dJ/dw = {}",
                 e.grad_w[0]
             );
             assert!(
-                (e.mixed_wv[0] - dwv).abs() <= tol,
+                abs_diff_eq!(e.mixed_wv[0], dwv, epsilon = tol),
                 "{line}: d2J = {}",
                 e.mixed_wv[0]
             );
@@ -180,30 +186,25 @@ fn preset_optimum_matches_the_published_values() {
     ] {
         let o = ClosedFormOracle::new(&model).unwrap();
         let opt = o.optimal_gain().unwrap();
-        assert!(
-            (opt.v[0] - (-0.615251245663011)).abs() < 1e-14,
-            "{:?}",
-            opt.v
-        );
-        assert!((opt.v[0] - v_star(0.99)).abs() < 1e-14);
+        assert_abs_diff_eq!(opt.v[0], -0.615251245663011, epsilon = 1e-14);
+        assert_abs_diff_eq!(opt.v[0], v_star(0.99), epsilon = 1e-14);
         // Published to 6 decimals.
-        assert!(
-            (opt.j_deterministic - j_ref).abs() < 5e-7,
-            "{}",
-            opt.j_deterministic
-        );
+        assert_abs_diff_eq!(opt.j_deterministic, j_ref, epsilon = 5e-7);
         // Scalar Lyapunov formula P = q(1 + v²)/(1 − γ(1 + v)²), J = −P E[s0²].
         let q = model.q[(0, 0)];
         let s2 = model.init_high[0].powi(2) / 3.0;
         let v = opt.v[0];
         let p = q * (1.0 + v * v) / (1.0 - 0.99 * (1.0 + v).powi(2));
-        assert!((opt.j_deterministic + p * s2).abs() < 1e-13 * p * s2);
-        assert!((opt.p[(0, 0)] - p).abs() < 1e-13 * p);
+        assert_relative_eq!(opt.j_deterministic, -p * s2, max_relative = 1e-13);
+        assert_relative_eq!(opt.p[(0, 0)], p, max_relative = 1e-13);
     }
     for gamma in [0.1, 0.5, 0.9, 0.999] {
         let m = LqgModel::thesis().with_gamma(gamma).unwrap();
         let opt = ClosedFormOracle::new(&m).unwrap().optimal_gain().unwrap();
-        assert!((opt.v[0] - v_star(gamma)).abs() < 1e-13, "γ = {gamma}");
+        assert!(
+            abs_diff_eq!(opt.v[0], v_star(gamma), epsilon = 1e-13),
+            "γ = {gamma}"
+        );
     }
 }
 
@@ -259,7 +260,7 @@ fn scalar_infinite_horizon_matches_the_lyapunov_formula() {
         let (g, q, s) = (0.99, 0.9, f64::exp(w));
         let p = q * (1.0 + v * v) / (1.0 - g * (1.0 + v).powi(2));
         let j = -p * (16.0 / 3.0 + g * (s * s + eta * eta) / (1.0 - g)) - q * s * s / (1.0 - g);
-        assert!((e.j - j).abs() < 1e-12 * j.abs(), "{} vs {j}", e.j);
+        assert_relative_eq!(e.j, j, max_relative = 1e-12);
     }
 }
 
@@ -270,9 +271,9 @@ fn finite_horizon_converges_to_the_infinite_one() {
     let inf = o.evaluate(&[-0.4], &ex, Horizon::Infinite).unwrap();
     // γ^6000 ≈ 6e-27: the tail is far below rounding.
     let fin = o.evaluate(&[-0.4], &ex, Horizon::Finite(6000)).unwrap();
-    assert!((inf.j - fin.j).abs() < 1e-11 * inf.j.abs());
+    assert_relative_eq!(inf.j, fin.j, max_relative = 1e-11);
     for (a, b) in inf.grad_v.iter().zip(&fin.grad_v) {
-        assert!((a - b).abs() < 1e-10 * a.abs().max(1.0));
+        assert_relative_eq!(a, b, epsilon = 1e-10, max_relative = 1e-10);
     }
     let (ha, hb) = (inf.hessian.unwrap(), fin.hessian.unwrap());
     assert!((ha - hb).amax() < 1e-9);
@@ -284,9 +285,9 @@ fn deterministic_policy_is_the_zero_variance_limit() {
     for h in [Horizon::Finite(20), Horizon::Infinite] {
         let det = o.evaluate(&[-0.3], &Exploration::Deterministic, h).unwrap();
         let tiny = o.evaluate(&[-0.3], &gaussian(&[-25.0]), h).unwrap();
-        assert!((det.j - tiny.j).abs() < 1e-12 * det.j.abs());
-        assert!((det.grad_v[0] - tiny.grad_v[0]).abs() < 1e-12 * det.grad_v[0].abs());
-        assert!(tiny.grad_w[0].abs() < 1e-18);
+        assert_relative_eq!(det.j, tiny.j, max_relative = 1e-12);
+        assert_relative_eq!(det.grad_v[0], tiny.grad_v[0], max_relative = 1e-12);
+        assert_abs_diff_eq!(tiny.grad_w[0], 0.0, epsilon = 1e-18);
         assert!(det.grad_w.is_empty() && det.mixed_wv.is_empty() && det.sigma.is_empty());
         assert_eq!(det.hessian.as_ref().unwrap().shape(), (1, 1));
     }
@@ -308,9 +309,13 @@ fn mixed_layout_and_sigma_conversions() {
             assert_eq!(e.mixed_wv[j * m + k], h[(m + j, k)]);
             assert_eq!(e.mixed_wv[j * m + k], h[(k, m + j)]);
             let s = f64::exp(case.w[j]);
-            assert!((e.mixed_sigma_v()[j * m + k] - e.mixed_wv[j * m + k] / s).abs() < 1e-15);
+            assert_abs_diff_eq!(
+                e.mixed_sigma_v()[j * m + k],
+                e.mixed_wv[j * m + k] / s,
+                epsilon = 1e-15
+            );
         }
-        assert!((e.grad_sigma()[j] * e.sigma[j] - e.grad_w[j]).abs() < 1e-13);
+        assert_abs_diff_eq!(e.grad_sigma()[j] * e.sigma[j], e.grad_w[j], epsilon = 1e-13);
     }
 }
 
@@ -329,7 +334,8 @@ fn unstable_closed_loop_is_a_typed_error() {
         .evaluate(&[v], &Exploration::Deterministic, Horizon::Infinite)
         .unwrap();
     let p = 0.5 * (1.0 + v * v) / (1.0 - 0.99 * (1.0 + v).powi(2));
-    assert!((e.j + p * 4.0 / 3.0).abs() < 1e-7 * p);
+    // 1e-7 in units of P, i.e. 7.5e-8 in units of |J| = 4P/3.
+    assert_relative_eq!(e.j, -p * 4.0 / 3.0, max_relative = 7.5e-8);
     // Finite horizon of an unstable loop is finite; an overflowing one is a typed error.
     assert!(
         o.evaluate(&[2.0], &Exploration::Deterministic, Horizon::Finite(50))
@@ -408,7 +414,7 @@ proptest! {
         };
         let e = o.evaluate(&case.v, &ex, Horizon::Finite(h)).unwrap();
         let j = forward_moments_j(&case.model, &case.v, &sigma, h);
-        prop_assert!((e.j - j).abs() <= 1e-11 * j.abs().max(1.0), "{} vs {}", e.j, j);
+        prop_assert!(relative_eq!(e.j, j, epsilon = 1e-11, max_relative = 1e-11), "{} vs {}", e.j, j);
     }
 
     /// Gradient, mixed derivative and Hessian against fourth-order central differences:

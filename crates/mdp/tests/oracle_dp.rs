@@ -4,7 +4,7 @@
 //! stochastic DP, and typed errors. The cost of one evaluation is measured by the `oracle`
 //! bench (`cargo bench -p sepg-benches --bench oracle`).
 
-use approx::abs_diff_eq;
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 use proptest::test_runner::{FileFailurePersistence, RngSeed};
@@ -100,7 +100,8 @@ fn unclipped_limit_matches_the_closed_form() {
                 let bd = cf
                     .evaluate(&[v], &Exploration::Deterministic, Horizon::Finite(h))
                     .unwrap();
-                assert!((ad.j - bd.j).abs() < tol && (ad.grad_v[0] - bd.grad_v[0]).abs() < tol);
+                assert_abs_diff_eq!(ad.j, bd.j, epsilon = tol);
+                assert_abs_diff_eq!(ad.grad_v[0], bd.grad_v[0], epsilon = tol);
             }
         }
     }
@@ -214,7 +215,7 @@ fn partial_requests_match_the_full_evaluation() {
         for (needs, [gv, gw, mixed]) in levels {
             let e = o.evaluate_with(&[v], &ex, h, needs).unwrap();
             assert!(
-                (e.j - full.j).abs() <= tol,
+                abs_diff_eq!(e.j, full.j, epsilon = tol),
                 "{needs:?}: J {} vs {}",
                 e.j,
                 full.j
@@ -226,7 +227,7 @@ fn partial_requests_match_the_full_evaluation() {
             ] {
                 if present {
                     assert!(
-                        (got[0] - want[0]).abs() <= tol,
+                        abs_diff_eq!(got[0], want[0], epsilon = tol),
                         "{needs:?}: {got:?} vs {want:?}"
                     );
                 } else {
@@ -263,7 +264,7 @@ fn small_sigma_is_accurate_or_a_typed_error() {
                     .unwrap();
                 let scale = det.j.abs().max(1.0);
                 assert!(
-                    (e.j - det.j).abs() < 1e-4 * scale,
+                    abs_diff_eq!(e.j, det.j, epsilon = 1e-4 * scale),
                     "v={v} σ={sigma}: {} vs {}",
                     e.j,
                     det.j
@@ -345,7 +346,7 @@ fn deterministic_exact_method_matches_brute_force_integration() {
             .unwrap();
         let scale = e.j.abs().max(1.0);
         assert!(
-            (e.j - brute(v)).abs() < 1e-8 * scale,
+            abs_diff_eq!(e.j, brute(v), epsilon = 1e-8 * scale),
             "{} vs {}",
             e.j,
             brute(v)
@@ -356,7 +357,7 @@ fn deterministic_exact_method_matches_brute_force_integration() {
                 .j
         });
         assert!(
-            (fd - e.grad_v[0]).abs() < 1e-7 * scale,
+            abs_diff_eq!(fd, e.grad_v[0], epsilon = 1e-7 * scale),
             "{} vs {fd}",
             e.grad_v[0]
         );
@@ -387,9 +388,13 @@ fn deterministic_policy_is_the_small_sigma_limit() {
         let g0 = (4.0 * e2.grad_v[0] - e1.grad_v[0]) / 3.0;
         let det = o.evaluate(&[v], &Exploration::Deterministic, h).unwrap();
         let scale = det.j.abs().max(1.0);
-        assert!((j0 - det.j).abs() < 1e-7 * scale, "{j0} vs {}", det.j);
         assert!(
-            (g0 - det.grad_v[0]).abs() < 1e-6 * scale,
+            abs_diff_eq!(j0, det.j, epsilon = 1e-7 * scale),
+            "{j0} vs {}",
+            det.j
+        );
+        assert!(
+            abs_diff_eq!(g0, det.grad_v[0], epsilon = 1e-6 * scale),
             "{g0} vs {}",
             det.grad_v[0]
         );
@@ -458,7 +463,7 @@ fn typed_errors() {
     let det = o
         .evaluate(&[-1.5], &Exploration::Deterministic, Horizon::Finite(20))
         .unwrap();
-    assert!((tiny.j - det.j).abs() < 1e-5, "{} vs {}", tiny.j, det.j);
+    assert_abs_diff_eq!(tiny.j, det.j, epsilon = 1e-5);
     let two_d = LqgModel::new(
         DMatrix::identity(2, 2),
         DMatrix::identity(2, 1),

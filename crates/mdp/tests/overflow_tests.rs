@@ -2,6 +2,7 @@
 //! finite but extreme inputs used to overflow into ±∞ or NaN that public functions returned
 //! as values. Each now gives a typed error.
 
+use approx::assert_abs_diff_eq;
 use nalgebra::DVector;
 use sepg_mdp::env::LqgEnv;
 use sepg_mdp::features::{FeatureError, RbfGrid};
@@ -105,7 +106,7 @@ fn confidence_levels_within_an_ulp_of_one_keep_a_finite_interval() {
     );
     // z(1 − 2^-53) ≈ 8.29 (normal upper quantile of 5.55e-17).
     let z = (e.ci_high - e.mean) / e.std_error;
-    assert!((z - 8.292).abs() < 1e-3, "{z}");
+    assert_abs_diff_eq!(z, 8.292, epsilon = 1e-3);
     // Overflow of mean ± z·SE is an error.
     assert!(summarize(&[f64::MAX, -f64::MAX, f64::MAX], 0.95).is_err());
 }

@@ -1,37 +1,19 @@
 //! Rollout engine (determinism across thread counts, padding, score identities) and the Monte
 //! Carlo oracle against closed forms.
 
-use nalgebra::{DMatrix, DVector};
+use approx::{assert_abs_diff_eq, relative_eq};
+use nalgebra::DVector;
 use sepg_mdp::Batch;
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
-use sepg_mdp::lqg_model::{BoxBounds, LqgModel};
+use sepg_mdp::lqg_model::LqgModel;
 use sepg_mdp::monte_carlo::{estimate_j, estimate_j_deterministic, estimate_j_difference};
 use sepg_mdp::mountain_car::MountainCar;
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::{RolloutError, rollout, rollout_into, rollout_returns};
 
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool")
-}
-
-fn lqg_2d() -> LqgEnv {
-    let model = LqgModel::new(
-        DMatrix::from_row_slice(2, 2, &[0.9, 0.2, -0.1, 1.0]),
-        DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.5, 1.0]),
-        DMatrix::identity(2, 2),
-        DMatrix::from_row_slice(2, 2, &[0.5, 0.1, 0.1, 0.5]),
-        BoxBounds::cube(2, -3.0, 3.0),
-        BoxBounds::cube(2, -1.0, 1.0),
-        BoxBounds::cube(2, -2.0, 2.0),
-    )
-    .and_then(|m| m.with_noise(DVector::from_vec(vec![0.1, 0.05])))
-    .expect("valid model");
-    LqgEnv::new(model).expect("valid env")
-}
+mod common;
+use common::{lqg_2d, pool};
 
 /// Bang-bang-like energy pumping on Mountain Car, μ = 100·vel (state+bias features): reaches
 /// the goal in about a hundred steps.
@@ -156,13 +138,13 @@ fn replay_and_check(env: &AnyEnv, pi: &GaussianPolicy, b: &Batch, key: SeedKey, 
         }
         for (x, y) in b.score_v(i, t).iter().zip(&cv) {
             assert!(
-                (x - y).abs() <= 1e-12 * (1.0 + y.abs()),
+                relative_eq!(x, y, epsilon = 1e-12, max_relative = 1e-12),
                 "v-score {i} {t}: {x} vs {y}"
             );
         }
         for (x, y) in b.score_w(i, t).iter().zip(&cw) {
             assert!(
-                (x - y).abs() <= 1e-12 * (1.0 + y.abs()),
+                relative_eq!(x, y, epsilon = 1e-12, max_relative = 1e-12),
                 "w-score {i} {t}: {x} vs {y}"
             );
         }
@@ -270,7 +252,11 @@ fn monte_carlo_deterministic_lqg_matches_closed_form() {
     let (v, h, gamma) = (-0.5, 20, 0.99);
     let ratio = gamma * (1.0f64 + v).powi(2);
     let exact = -(4.0 / 3.0) * (0.5 + 0.5 * v * v) * (1.0 - ratio.powi(h as i32)) / (1.0 - ratio);
-    assert!((exact - lqg_j(0.5, 0.5, gamma, 4.0 / 3.0, v, 0.0, h)).abs() < 1e-12);
+    assert_abs_diff_eq!(
+        exact,
+        lqg_j(0.5, 0.5, gamma, 4.0 / 3.0, v, 0.0, h),
+        epsilon = 1e-12
+    );
     let pi = GaussianPolicy::scalar(v, 0.0).unwrap();
     let e = estimate_j_deterministic(
         &LqgEnv::thesis(),

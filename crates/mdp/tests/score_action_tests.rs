@@ -2,38 +2,17 @@
 //! kernel (fused scalar LQG lanes, generic, fused Mountain Car, the streaming sinks) against
 //! an independent step-by-step replay, and the raw scores unchanged bit for bit.
 
-use nalgebra::{DMatrix, DVector};
+use approx::relative_eq;
 use sepg_mdp::Batch;
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
-use sepg_mdp::lqg_model::{BoxBounds, LqgModel};
 use sepg_mdp::monte_carlo::{pilot_key, stream_gradients, stream_gradients_with};
 use sepg_mdp::mountain_car::MountainCar;
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::{ScoreAction, rollout, rollout_into, rollout_into_with};
 
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool")
-}
-
-/// A clipped two-dimensional LQG with noise (generic kernel), action box `[−1, 1]²`.
-fn lqg_2d() -> LqgEnv {
-    let model = LqgModel::new(
-        DMatrix::from_row_slice(2, 2, &[0.9, 0.2, -0.1, 1.0]),
-        DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.5, 1.0]),
-        DMatrix::identity(2, 2),
-        DMatrix::from_row_slice(2, 2, &[0.5, 0.1, 0.1, 0.5]),
-        BoxBounds::cube(2, -3.0, 3.0),
-        BoxBounds::cube(2, -1.0, 1.0),
-        BoxBounds::cube(2, -2.0, 2.0),
-    )
-    .and_then(|m| m.with_noise(DVector::from_vec(vec![0.1, 0.05])))
-    .expect("valid model");
-    LqgEnv::new(model).expect("valid env")
-}
+mod common;
+use common::{lqg_2d, pool};
 
 /// One case: environment, policy, horizon, and its action box `[−bound, bound]` per
 /// component, written here from the environments' definitions (not from the engine).
@@ -78,6 +57,13 @@ fn cases() -> Vec<Case> {
     ]
 }
 
+/// A batch of `n` trajectories of `case` with its scores evaluated at `action`.
+fn scored_batch(case: &Case, n: usize, key: SeedKey, action: ScoreAction) -> Batch {
+    let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
+    rollout_into_with(&case.env, &case.pi, n, case.h, key, action, &mut b).unwrap();
+    b
+}
+
 /// Replays trajectory `i` with the public step-by-step API and checks its rows of `b`:
 /// rewards bit for bit (the trajectory does not depend on the scored action), cumulative
 /// scores against `policy.score_v/score_w` evaluated at `clip(a)` (relative 1e-12), and the
@@ -114,7 +100,7 @@ fn replay_clipped(case: &Case, b: &Batch, key: SeedKey, i: usize) -> (usize, usi
         let got = b.score_v(i, t).iter().chain(b.score_w(i, t));
         for (x, y) in got.zip(cv.iter().chain(&cw)) {
             assert!(
-                (x - y).abs() <= 1e-12 * (1.0 + y.abs()),
+                relative_eq!(x, y, epsilon = 1e-12, max_relative = 1e-12),
                 "score {i} {t}: {x} vs {y}"
             );
         }
@@ -140,17 +126,7 @@ fn replay_clipped(case: &Case, b: &Batch, key: SeedKey, i: usize) -> (usize, usi
 fn clipped_scores_match_an_independent_replay() {
     for case in cases() {
         let key = SeedKey::new(21, 0, 2);
-        let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
-        rollout_into_with(
-            &case.env,
-            &case.pi,
-            70,
-            case.h,
-            key,
-            ScoreAction::Clipped,
-            &mut b,
-        )
-        .unwrap();
+        let b = scored_batch(&case, 70, key, ScoreAction::Clipped);
         let (mut steps, mut clipped) = (0, 0);
         for i in 0..b.n {
             let (s, c) = replay_clipped(&case, &b, key, i);
@@ -176,7 +152,10 @@ fn clipped_scores_equal_raw_scores_inside_the_box() {
     rollout_into_with(&env, &pi, 30, 20, key, ScoreAction::Clipped, &mut clipped).unwrap();
     let pairs = raw.cum_score_v.iter().zip(&clipped.cum_score_v);
     for (x, y) in pairs.chain(raw.cum_score_w.iter().zip(&clipped.cum_score_w)) {
-        assert!((x - y).abs() <= 1e-9 * (1.0 + x.abs()), "{x} vs {y}");
+        assert!(
+            relative_eq!(x, y, epsilon = 1e-9, max_relative = 1e-9),
+            "{x} vs {y}"
+        );
     }
 }
 
@@ -187,20 +166,7 @@ fn clipped_scores_are_the_same_bits_for_any_thread_count() {
     for case in cases() {
         let key = SeedKey::new(7, 3, 1);
         let run = |threads: usize| {
-            pool(threads).install(|| {
-                let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
-                rollout_into_with(
-                    &case.env,
-                    &case.pi,
-                    203,
-                    case.h,
-                    key,
-                    ScoreAction::Clipped,
-                    &mut b,
-                )
-                .unwrap();
-                b
-            })
+            pool(threads).install(|| scored_batch(&case, 203, key, ScoreAction::Clipped))
         };
         let one = run(1);
         assert_eq!(one, run(2));
@@ -254,7 +220,7 @@ fn streamed_gradients_on_clipped_scores_match_stored_batches() {
                 g.grad_w[k - dv].mean()
             };
             assert!(
-                (got - mean).abs() <= 1e-12 * (1.0 + mean.abs()),
+                relative_eq!(got, mean, epsilon = 1e-12, max_relative = 1e-12),
                 "component {k}: {got} vs {mean}"
             );
         }
@@ -295,18 +261,7 @@ fn raw_scores_are_unchanged() {
         let key = SeedKey::new(21, 0, 2);
         let mut b = Batch::zeros(0, 0, 0, 0, 0.0);
         rollout_into(&case.env, &case.pi, 70, case.h, key, &mut b).unwrap();
-        let mut r = Batch::zeros(0, 0, 0, 0, 0.0);
-        rollout_into_with(
-            &case.env,
-            &case.pi,
-            70,
-            case.h,
-            key,
-            ScoreAction::Raw,
-            &mut r,
-        )
-        .unwrap();
-        assert_eq!(b, r);
+        assert_eq!(b, scored_batch(case, 70, key, ScoreAction::Raw));
         assert_eq!(digest(&b), want, "{:#018x}", digest(&b));
     }
 }

@@ -2,12 +2,12 @@
 //! an independent computation from stored batches, and unbiased against the exact clipped-LQG
 //! oracle.
 
-use nalgebra::{DMatrix, DVector};
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 use sepg_mdp::Batch;
 use sepg_mdp::env::{AnyEnv, LqgEnv};
-use sepg_mdp::lqg_model::{BoxBounds, LqgModel};
+use sepg_mdp::lqg_model::LqgModel;
 use sepg_mdp::monte_carlo::{
     BLOCK, GradientMoments, Moments, estimate_j_difference, pilot_key, stream_gradients,
     stream_returns,
@@ -19,27 +19,8 @@ use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::{rollout, rollout_returns};
 use statrs::distribution::{ContinuousCDF, Normal};
 
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool")
-}
-
-fn lqg_2d() -> LqgEnv {
-    let model = LqgModel::new(
-        DMatrix::from_row_slice(2, 2, &[0.9, 0.2, -0.1, 1.0]),
-        DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.5, 1.0]),
-        DMatrix::identity(2, 2),
-        DMatrix::from_row_slice(2, 2, &[0.5, 0.1, 0.1, 0.5]),
-        BoxBounds::cube(2, -3.0, 3.0),
-        BoxBounds::cube(2, -1.0, 1.0),
-        BoxBounds::cube(2, -2.0, 2.0),
-    )
-    .and_then(|m| m.with_noise(DVector::from_vec(vec![0.1, 0.05])))
-    .expect("valid model");
-    LqgEnv::new(model).expect("valid env")
-}
+mod common;
+use common::{lqg_2d, pool};
 
 /// (environment, policy, n, horizon): the fused scalar kernel (n crosses a 64-item round and
 /// is not a multiple of the block or of the lane count), the generic kernel with two actions
@@ -206,7 +187,8 @@ fn streamed_gradients_equal_an_independent_computation_from_batches() {
                 .collect();
             assert_eq!(got.len(), want.len());
             for (c, (a, b)) in got.iter().zip(&want).enumerate() {
-                let close = |x: f64, y: f64, scale: f64| (x - y).abs() <= 1e-12 * scale;
+                let close =
+                    |x: f64, y: f64, scale: f64| abs_diff_eq!(x, y, epsilon = 1e-12 * scale);
                 let sd = b.variance().sqrt();
                 assert_eq!(a.count(), n as u64);
                 assert!(
@@ -237,8 +219,12 @@ fn streamed_returns_equal_the_stored_returns() {
         let want = Moments::from_samples(&g);
         let (got, _) = stream_returns(&env, &pi, n, h, key).unwrap();
         let sd = want.variance().sqrt();
-        assert!((got.mean() - want.mean()).abs() <= 1e-12 * (sd + want.mean().abs()));
-        assert!((got.variance() - want.variance()).abs() <= 1e-12 * want.variance());
+        assert_abs_diff_eq!(
+            got.mean(),
+            want.mean(),
+            epsilon = 1e-12 * (sd + want.mean().abs())
+        );
+        assert_relative_eq!(got.variance(), want.variance(), max_relative = 1e-12);
     }
 }
 
@@ -263,12 +249,19 @@ fn merged_moments_equal_the_moments_of_the_whole_sample() {
             start = end;
         }
         assert_eq!(merged.count(), whole.count());
-        assert!((merged.mean() - whole.mean()).abs() <= 4.0 * f64::EPSILON * 1e8);
-        let rel = (merged.variance() - whole.variance()).abs() / whole.variance();
-        assert!(rel <= 1e-7, "relative variance error {rel:e}");
+        assert_abs_diff_eq!(
+            merged.mean(),
+            whole.mean(),
+            epsilon = 4.0 * f64::EPSILON * 1e8
+        );
+        assert_relative_eq!(merged.variance(), whole.variance(), max_relative = 1e-7);
     }
     // Uniform on [0, 1) + 1e8: variance 1/12 (sampling error ~ 1/12 · √(2/n)).
-    assert!((whole.variance() - 1.0 / 12.0).abs() < 5.0 * (1.0 / 12.0) * (2.0f64 / 1e4).sqrt());
+    assert_abs_diff_eq!(
+        whole.variance(),
+        1.0 / 12.0,
+        epsilon = 5.0 * (1.0 / 12.0) * (2.0f64 / 1e4).sqrt()
+    );
 }
 
 #[test]

@@ -2,11 +2,17 @@
 //! and resumes it bit for bit.
 //!
 //! Rows are appended in chunks of `checkpoint_every` iterations; after each chunk the log is
-//! flushed to disk and the checkpoint is replaced atomically. A run killed at any point
-//! therefore leaves a checkpoint whose state matches the first `log_bytes` bytes of
-//! `log.partial.csv`, and resuming truncates the log there and continues. Because every batch
-//! of trajectories is seeded by (seed, iteration, block), the resumed run produces the same
-//! rows, bit for bit, as an uninterrupted one.
+//! flushed to disk and the checkpoint is replaced atomically. When every iteration is done,
+//! `log.partial.csv` is renamed to `log.csv` and then `summary.json` is written. A run killed
+//! at any point therefore leaves one of three folders, each of which every reader recognises:
+//! - no `log.csv`: a checkpoint whose state matches the first `log_bytes` bytes of
+//!   `log.partial.csv` (resuming truncates the log there and continues);
+//! - `log.csv` but no `summary.json`: every row is written and the checkpoint holds the final
+//!   state (the run is still incomplete; resuming writes only the summary);
+//! - `summary.json`: the run is complete.
+//!
+//! Because every batch of trajectories is seeded by (seed, iteration, block), the resumed run
+//! produces the same rows, bit for bit, as an uninterrupted one.
 //!
 //! A run stops early, after checkpointing, when its stop flag is raised (the command line
 //! raises it on Ctrl-C); it reports its progress to an [`Observer`].
@@ -38,6 +44,14 @@ pub trait Observer: Sync {
     fn advance(&self, _done: u64) {}
     /// Called once when the work ends, whether it completed or not.
     fn end(&self) {}
+    /// Called each time a file of the run folder has been given its new contents on disk:
+    /// `file` is the name of the file written (one of [`crate::folder::RUN_FILES`]). The run
+    /// writes its folder in steps (the partial log, then the checkpoint, then the
+    /// configuration when it starts; rows appended to the partial log, then the checkpoint
+    /// replaced, at each checkpoint; the partial log renamed to the log, then the summary, when
+    /// it ends), and a process killed between two calls leaves the folder as it was at the
+    /// last one.
+    fn wrote(&self, _file: &str) {}
 }
 
 /// The observer that ignores every report.
@@ -68,6 +82,7 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
     fs::create_dir_all(dir).map_err(|e| io_fail("create", dir, e))?;
     let header = log_header(resolved.dims.0, resolved.dims.1);
     write_atomic(&dir.join(PARTIAL_LOG_FILE), header.as_bytes())?;
+    opts.observer.wrote(PARTIAL_LOG_FILE);
     let ck = Checkpoint {
         log_bytes: header.len() as u64,
         elapsed_s: 0.0,
@@ -75,8 +90,10 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
         state: resolved.checked.initial_state(),
     };
     write_atomic(&dir.join(CHECKPOINT_FILE), to_json_line(&ck)?.as_bytes())?;
+    opts.observer.wrote(CHECKPOINT_FILE);
     // The configuration goes last: a folder with a config.toml always has a checkpoint.
     write_atomic(&dir.join(CONFIG_FILE), resolved.toml()?.as_bytes())?;
+    opts.observer.wrote(CONFIG_FILE);
     drive(dir, resolved, ck, opts)
 }
 
@@ -103,9 +120,10 @@ pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
     let finished = dir.join(LOG_FILE);
     if !partial.exists() && finished.is_file() && ck.state.iteration == resolved.iterations() {
         // Killed between the final rename and the summary: only the summary is missing.
-        return finish(dir, &resolved, &ck);
+        return finish(dir, &resolved, &ck, opts.observer);
     }
     truncate_log(&partial, ck.log_bytes)?;
+    opts.observer.wrote(PARTIAL_LOG_FILE);
     drive(dir, &resolved, ck, opts)
 }
 
@@ -158,12 +176,13 @@ impl Writer {
     }
 
     /// Appends the buffered rows to the log, syncs it, and replaces the checkpoint by one for
-    /// `tally` and `state`.
-    fn checkpoint(&mut self, tally: &Tally, state: &State) -> Result<()> {
+    /// `tally` and `state`, telling `observer` after each of the two writes.
+    fn checkpoint(&mut self, tally: &Tally, state: &State, observer: &dyn Observer) -> Result<()> {
         self.log
             .write_all(self.chunk.as_bytes())
             .and_then(|()| self.log.sync_data())
             .map_err(|e| io_fail("write", &self.partial, e))?;
+        observer.wrote(PARTIAL_LOG_FILE);
         self.ck = Checkpoint {
             log_bytes: self.ck.log_bytes + self.chunk.len() as u64,
             elapsed_s: self.ck.elapsed_s + self.segment.elapsed().as_secs_f64(),
@@ -175,7 +194,9 @@ impl Writer {
         write_atomic(
             &self.dir.join(CHECKPOINT_FILE),
             to_json_line(&self.ck)?.as_bytes(),
-        )
+        )?;
+        observer.wrote(CHECKPOINT_FILE);
+        Ok(())
     }
 }
 
@@ -203,7 +224,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
                 opts.observer.end();
                 // Keep every row computed so far: checkpoint the state the failing iteration
                 // started from, with the rows up to it.
-                writer.checkpoint(&tally, &before)?;
+                writer.checkpoint(&tally, &before, opts.observer)?;
                 return Err(Error::failed(format!(
                     "{}: iteration {} failed ({e}); the {} row(s) before it are kept in {PARTIAL_LOG_FILE}",
                     dir.display(),
@@ -219,7 +240,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
         opts.observer.advance(state.iteration);
         let stop = opts.stop.load(Ordering::SeqCst);
         if state.iteration.is_multiple_of(period) || state.iteration == total || stop {
-            writer.checkpoint(&tally, &state)?;
+            writer.checkpoint(&tally, &state, opts.observer)?;
             if stop && state.iteration < total {
                 opts.observer.end();
                 return Err(Error::Interrupted {
@@ -236,11 +257,17 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     } = writer;
     drop(log);
     fs::rename(&partial, dir.join(LOG_FILE)).map_err(|e| io_fail("rename", &partial, e))?;
-    finish(dir, resolved, &ck)
+    opts.observer.wrote(LOG_FILE);
+    finish(dir, resolved, &ck, opts.observer)
 }
 
 /// Writes `summary.json` from the final checkpoint `ck`, completing the run.
-fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
+fn finish(
+    dir: &Path,
+    resolved: &Resolved,
+    ck: &Checkpoint,
+    observer: &dyn Observer,
+) -> Result<Summary> {
     let s = &ck.state;
     let v_star = resolved.v_star();
     let abs_v_error = v_star.as_ref().map(|vs| {
@@ -288,6 +315,7 @@ fn finish(dir: &Path, resolved: &Resolved, ck: &Checkpoint) -> Result<Summary> {
         certified_steps: resolved.spec.certified_steps,
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
+    observer.wrote(SUMMARY_FILE);
     Ok(summary)
 }
 
@@ -307,6 +335,159 @@ mod tests {
             if done == self.at {
                 self.stop.store(true, Ordering::SeqCst);
             }
+        }
+    }
+
+    /// Counts the folder writes and aborts the process (no destructor or unwinding runs, as
+    /// under SIGKILL) right after the `after`-th one.
+    struct AbortAfter {
+        after: usize,
+        count: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Observer for AbortAfter {
+        fn wrote(&self, _file: &str) {
+            if self.count.fetch_add(1, Ordering::SeqCst) + 1 == self.after {
+                std::process::abort();
+            }
+        }
+    }
+
+    /// Records the name of every file written, in order.
+    #[derive(Default)]
+    struct Writes(std::sync::Mutex<Vec<String>>);
+
+    impl Observer for Writes {
+        fn wrote(&self, file: &str) {
+            self.0.lock().expect("lock").push(file.to_owned());
+        }
+    }
+
+    /// Set in the child process of [`a_run_killed_after_any_write_resumes_to_the_uninterrupted_run`]:
+    /// the write after which it aborts, and its run folder.
+    const ABORT_AFTER: &str = "SEPG_RUNS_TEST_ABORT_AFTER_WRITE";
+    const ABORT_DIR: &str = "SEPG_RUNS_TEST_ABORT_DIR";
+
+    fn nine_iterations() -> Resolved {
+        RunSpec {
+            iterations: Some(9),
+            batch: Some(10),
+            algo: Some(crate::spec::AlgoName::SepgLb2),
+            ..RunSpec::default()
+        }
+        .resolve()
+        .expect("valid")
+    }
+
+    /// Asserts that the folder `dir` of a run killed at any instant is one of the three the
+    /// module documentation lists, given the log of the same run uninterrupted. Returns whether
+    /// `dir` is a run folder yet (it has a configuration).
+    fn assert_consistent(dir: &Path, reference_log: &str, total: u64) -> bool {
+        if !dir.join(CONFIG_FILE).exists() {
+            return false;
+        }
+        let ck: Checkpoint = serde_json::from_str(
+            &fs::read_to_string(dir.join(CHECKPOINT_FILE)).expect("checkpoint"),
+        )
+        .expect("valid checkpoint");
+        let valid = usize::try_from(ck.log_bytes).expect("log_bytes");
+        if dir.join(LOG_FILE).exists() {
+            // All rows written: the final checkpoint vouches for the whole log.
+            assert!(!dir.join(PARTIAL_LOG_FILE).exists());
+            assert_eq!(ck.state.iteration, total);
+            assert_eq!(
+                fs::read_to_string(dir.join(LOG_FILE)).expect("log"),
+                reference_log
+            );
+            assert_eq!(valid, reference_log.len());
+        } else {
+            assert!(!is_complete(dir), "summary.json without log.csv");
+            let partial = fs::read_to_string(dir.join(PARTIAL_LOG_FILE)).expect("partial log");
+            assert!(partial.len() >= valid);
+            // The checkpointed prefix is the uninterrupted log's, cut after the row of the
+            // checkpoint's last iteration (one row per iteration here).
+            assert_eq!(partial[..valid], reference_log[..valid]);
+            let rows = reference_log[..valid].lines().count();
+            assert_eq!(
+                rows as u64,
+                ck.state.iteration + 1,
+                "header and one row each"
+            );
+        }
+        true
+    }
+
+    /// Kills a run right after each of its folder writes in turn (a child process that aborts,
+    /// which like SIGKILL runs no destructor), checks the folder it leaves, resumes it, and
+    /// compares with the uninterrupted run: a deterministic cover of every point a SIGKILL can
+    /// land between two writes.
+    #[cfg(unix)]
+    #[test]
+    fn a_run_killed_after_any_write_resumes_to_the_uninterrupted_run() {
+        use std::os::unix::process::ExitStatusExt;
+
+        let never = AtomicBool::new(false);
+        let opts = |observer| RunOptions {
+            checkpoint_every: 4,
+            stop: &never,
+            observer,
+        };
+        if let (Ok(after), Ok(dir)) = (std::env::var(ABORT_AFTER), std::env::var(ABORT_DIR)) {
+            let observer = AbortAfter {
+                after: after.parse().expect("write index"),
+                count: Default::default(),
+            };
+            start(Path::new(&dir), &nine_iterations(), opts(&observer)).expect("run");
+            return;
+        }
+        let resolved = nine_iterations();
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let whole = tmp.path().join("whole");
+        let writes = Writes::default();
+        let reference = start(&whole, &resolved, opts(&writes)).expect("complete run");
+        let writes = writes.0.lock().expect("lock").clone();
+        let (p, c) = (PARTIAL_LOG_FILE, CHECKPOINT_FILE);
+        // Start; checkpoints after iterations 4, 8 and 9 (rows, then checkpoint); end.
+        let expected = [p, c, CONFIG_FILE, p, c, p, c, p, c, LOG_FILE, SUMMARY_FILE];
+        assert_eq!(writes, expected);
+        let reference_log = fs::read_to_string(whole.join(LOG_FILE)).expect("log");
+        for after in 1..=writes.len() {
+            let dir = tmp.path().join(format!("killed-after-{after}"));
+            let status = std::process::Command::new(std::env::current_exe().expect("test binary"))
+                .args([
+                    "run::tests::a_run_killed_after_any_write_resumes_to_the_uninterrupted_run",
+                    "--exact",
+                    "--test-threads=1",
+                ])
+                .env(ABORT_AFTER, after.to_string())
+                .env(ABORT_DIR, &dir)
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .status()
+                .expect("child");
+            assert_eq!(
+                status.signal(),
+                Some(6),
+                "the child aborts after write {after}"
+            );
+            if !assert_consistent(&dir, &reference_log, 9) {
+                // Killed before the configuration was written: not a run folder yet.
+                assert!(after < 3, "no configuration after write {after}");
+                assert!(matches!(
+                    resume(&dir, opts(&Silent)),
+                    Err(Error::Invalid(_))
+                ));
+                continue;
+            }
+            let summary = resume(&dir, opts(&Silent)).expect("resumed run");
+            assert_eq!(
+                fs::read_to_string(dir.join(LOG_FILE)).expect("log"),
+                reference_log
+            );
+            assert_eq!(summary.final_params.v, reference.final_params.v);
+            assert_eq!(summary.final_params.w, reference.final_params.w);
+            assert_eq!(summary.final_params.budget, reference.final_params.budget);
+            assert!(!dir.join(PARTIAL_LOG_FILE).exists());
         }
     }
 

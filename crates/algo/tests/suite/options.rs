@@ -3,6 +3,7 @@
 //! directions, constant overrides and the configuration errors of options that do not apply.
 //! About 3 s in release.
 use crate::suite::common::{exact, lqg, lqg1d, run};
+use approx::assert_relative_eq;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::error::ConfigError;
 use sepg_algo::core::options::{
@@ -80,13 +81,10 @@ fn reference_batch_is_an_upper_confidence_bound_on_j0() {
     let mean = returns.iter().sum::<f64>() / nf;
     let var = returns.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (nf - 1.0);
     let upper = mean + student_t_quantile(0.8, nf - 1.0).expect("quantile") * (var / nf).sqrt();
-    assert!((state.j0.expect("J(θ⁰)") - upper).abs() <= 1e-12 * upper.abs());
+    assert_relative_eq!(state.j0.expect("J(θ⁰)"), upper, max_relative = 1e-12);
     let expected = 0.5 * (upper - records[0].j_exploratory);
     let got = records[0].required_v.expect("C");
-    assert!(
-        (got - expected).abs() <= 1e-12 * expected.abs(),
-        "{got} vs {expected}"
-    );
+    assert_relative_eq!(got, expected, max_relative = 1e-12);
     assert_eq!(records[0].trajectories, 100 + n as u64);
     // Without it, J(θ⁰) is the first v-block's estimate and the first requirement is 0.
     let plain = SepgOptions {
@@ -151,7 +149,7 @@ fn plug_in_direction_is_exact_with_exact_gradients() {
     let ((a, _), (b, _)) = (run(base, 30), run(plug, 30));
     for (x, y) in a.iter().zip(&b) {
         for (p, q) in x.v.iter().chain(&x.w).zip(y.v.iter().chain(&y.w)) {
-            assert!((p - q).abs() <= 1e-12 * p.abs().max(1.0), "{p} vs {q}");
+            assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-12);
         }
     }
     assert!(a.last().expect("records").w[0] != a[0].w[0]);
@@ -189,11 +187,7 @@ fn metagradient_direction_matches_its_formula() {
         + (2.0 * sigma * alpha * g * mixed_sigma).clamp(-100.0, 100.0);
     let dw = state.w[0] - r.w[0];
     assert!(dw != 0.0);
-    assert!(
-        (dw - r.beta * m).abs() <= 1e-9 * dw.abs(),
-        "{dw} vs {}",
-        r.beta * m
-    );
+    assert_relative_eq!(dw, r.beta * m, max_relative = 1e-9);
 }
 
 #[test]
@@ -220,7 +214,7 @@ fn overrides_reach_the_bounds_and_the_environment() {
     // d = R/(1 − γ)² (ψ|A|/(2σ) + γ/(1 − γ)) with ψ = 0.53, computed by hand at σ = 1.
     let d = sepg_bounds::constants::d(k, 1.0).expect("d");
     let expected = 10.0 / 0.01 * (0.53 * 3.0 / 2.0 + 9.0);
-    assert!((d - expected).abs() <= 1e-9 * expected, "{d} vs {expected}");
+    assert_relative_eq!(d, expected, max_relative = 1e-9);
     assert_eq!(checked.config().env.constants().gamma, 0.9);
 }
 
