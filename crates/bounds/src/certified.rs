@@ -986,10 +986,11 @@ pub fn hp_v_safe_step(
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
     let cc = constants::c(k, sigma)?;
-    let outcome = match hp::HighProbabilityBound::v_update_with_c(cc, grad_v_hat, eps)? {
-        Some(b) => b.safe_step(required, form)?,
-        None => StepOutcome::BelowNoise,
-    };
+    let outcome = hp::safe_step_or_below_noise(
+        hp::HighProbabilityBound::v_update_with_c(cc, grad_v_hat, eps)?,
+        required,
+        form,
+    )?;
     certify_fast_then_interval(
         outcome,
         required,
@@ -1017,10 +1018,11 @@ pub fn hp_w_safe_step_along_j(
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = match hp::HighProbabilityBound::w_along_j_with_d(dd, grad_w_j_hat, eps)? {
-        Some(b) => b.safe_step(required, form)?,
-        None => StepOutcome::BelowNoise,
-    };
+    let outcome = hp::safe_step_or_below_noise(
+        hp::HighProbabilityBound::w_along_j_with_d(dd, grad_w_j_hat, eps)?,
+        required,
+        form,
+    )?;
     certify_fast_then_interval(
         outcome,
         required,
@@ -1051,10 +1053,11 @@ pub fn hp_w_safe_step_along_l(
     let (l, el) = grad_w_l_hat;
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = match hp::HighProbabilityBound::w_along_l_with_d(dd, j, ej, l, el)? {
-        Some(b) => b.safe_step(required, form)?,
-        None => StepOutcome::BelowNoise,
-    };
+    let outcome = hp::safe_step_or_below_noise(
+        hp::HighProbabilityBound::w_along_l_with_d(dd, j, ej, l, el)?,
+        required,
+        form,
+    )?;
     let fast = move || {
         let (nj, nl) = (j.abs(), l.abs());
         let (l_hi, j_hi) = (Rounded::sum(nl, el), Rounded::sum(nj, ej));

@@ -358,6 +358,21 @@ impl HighProbabilityBound {
     }
 }
 
+/// The safe steps of `bound` for the requirement C = `required` in the form `form`
+/// ([`HighProbabilityBound::safe_step`]), or [`StepOutcome::BelowNoise`] when there is no
+/// bound because the estimate is within its confidence width (eq. (4.23) fails).
+#[inline]
+pub(crate) fn safe_step_or_below_noise(
+    bound: Option<HighProbabilityBound>,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    match bound {
+        Some(b) => b.safe_step(required, form),
+        None => Ok(StepOutcome::BelowNoise),
+    }
+}
+
 /// Safe steps of Theorem 4.7 (eq. (4.26)) for an estimated ∇_v J, or
 /// [`StepOutcome::BelowNoise`].
 ///
@@ -385,10 +400,11 @@ pub fn v_safe_step(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    match HighProbabilityBound::v_update(k, sigma, grad_v_hat, eps)? {
-        Some(b) => b.safe_step(required, form),
-        None => Ok(StepOutcome::BelowNoise),
-    }
+    safe_step_or_below_noise(
+        HighProbabilityBound::v_update(k, sigma, grad_v_hat, eps)?,
+        required,
+        form,
+    )
 }
 
 /// Safe steps of Theorem 4.8 (eq. (4.29)) along an estimated ∇_w J, or
@@ -415,10 +431,11 @@ pub fn w_safe_step_along_j(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    match HighProbabilityBound::w_along_j(k, sigma, grad_w_j_hat, eps)? {
-        Some(b) => b.safe_step(required, form),
-        None => Ok(StepOutcome::BelowNoise),
-    }
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_j(k, sigma, grad_w_j_hat, eps)?,
+        required,
+        form,
+    )
 }
 
 /// Safe steps of Theorem 4.9 (eq. (4.30)) along an estimated ∇_w L, or
@@ -450,8 +467,9 @@ pub fn w_safe_step_along_l(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    match HighProbabilityBound::w_along_l(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)? {
-        Some(b) => b.safe_step(required, form),
-        None => Ok(StepOutcome::BelowNoise),
-    }
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_l(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
+        required,
+        form,
+    )
 }

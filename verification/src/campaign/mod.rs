@@ -699,11 +699,7 @@ pub fn run(config: &CampaignConfig) -> Vec<FormTally> {
     if config.adversarial {
         parts.push(run_adversarial(total));
     }
-    let mut out = empty();
-    for part in parts {
-        merge(&mut out, part);
-    }
-    out
+    merged(parts)
 }
 
 /// The random configurations of the chunks `chunks` (of 256) out of `total`, tallied in
@@ -720,6 +716,11 @@ pub fn run_random(seed: u64, total: u64, chunks: std::ops::Range<u64>) -> Vec<Fo
             run_cases((start..end).map(|i| (i, random_case(&mut rng))))
         })
         .collect();
+    merged(parts)
+}
+
+/// The tallies of `parts`, in order, added form by form.
+fn merged(parts: impl IntoIterator<Item = Vec<FormTally>>) -> Vec<FormTally> {
     let mut out = empty();
     for part in parts {
         merge(&mut out, part);
@@ -750,11 +751,7 @@ pub fn run_adversarial(random: u64) -> Vec<FormTally> {
             )
         })
         .collect();
-    let mut out = empty();
-    for part in parts {
-        merge(&mut out, part);
-    }
-    out
+    merged(parts)
 }
 
 /// Number of configurations in the adversarial grid.
