@@ -14,12 +14,12 @@ use sepg_verification::campaign::{
 
 fn print(tallies: &[FormTally]) {
     println!(
-        "| form | cases | uncertified steps | violated exactly | certified steps | by error bound | by interval | moved | max ulps | uncertifiable | certified violations | undecided | enclosure failures |"
+        "| form | cases | uncertified steps | violated exactly | certified steps | by error bound | by interval | moved | max ulps | uncertifiable | certified violations | undecided | enclosure failures | outcome mismatches |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for t in tallies {
         println!(
-            "| {} | {} | {} | {} ({:.1}%) | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} ({:.1}%) | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             t.form,
             t.cases,
             t.uncertified_steps,
@@ -33,7 +33,8 @@ fn print(tallies: &[FormTally]) {
             t.uncertifiable,
             t.certified_violations,
             t.undecided,
-            t.enclosure_failures
+            t.enclosure_failures,
+            t.outcome_mismatches
         );
     }
     for t in tallies {
@@ -99,12 +100,13 @@ fn campaign_full() {
         }
         let sum = |f: fn(&FormTally) -> u64| tallies.iter().map(f).sum::<u64>();
         eprintln!(
-            "random configurations done: {} of {RANDOM}; certified steps {}, certified violations {}, undecided {}, enclosure failures {}",
+            "random configurations done: {} of {RANDOM}; certified steps {}, certified violations {}, undecided {}, enclosure failures {}, outcome mismatches {}",
             (block(b).end * 256).min(RANDOM),
             sum(|t| t.certified_steps),
             sum(|t| t.certified_violations),
             sum(|t| t.undecided),
-            sum(|t| t.enclosure_failures)
+            sum(|t| t.enclosure_failures),
+            sum(|t| t.outcome_mismatches)
         );
     }
     merge(&mut tallies, run_adversarial(RANDOM));

@@ -772,12 +772,34 @@ fn certify_fast_then_interval<S: EnclosedBound>(
             return Ok(Certified::ZeroGradient { requirement_met });
         }
         StepOutcome::BelowNoise => return Ok(Certified::BelowNoise),
-        StepOutcome::Feasible(_) | StepOutcome::Infeasible { .. } => {}
-    }
-    if let Some(certified) = fast().and_then(|bound| certify_predicted(&bound, outcome, required)) {
-        return Ok(certified);
+        StepOutcome::Infeasible { vertex, .. } => {
+            if let Some(bound) = fast() {
+                return Ok(Certified::Infeasible {
+                    step: vertex,
+                    bound: bound.enclose(vertex),
+                });
+            }
+        }
+        StepOutcome::Feasible(s) => {
+            if let Some(step) = certify_feasible(Some(s), fast, required) {
+                return Ok(Certified::Step(step));
+            }
+        }
     }
     certify_by_interval(outcome, required, interval)
+}
+
+/// [`certify_fast_then_interval`] for the outcome that `outcome` computes, kept out of line:
+/// the fallback of the step functions whose common case [`certify_feasible`] handles.
+#[cold]
+#[inline(never)]
+fn certify_out_of_line<S: EnclosedBound>(
+    required: f64,
+    outcome: impl FnOnce() -> Result<StepOutcome, BoundsError>,
+    fast: impl FnOnce() -> Option<RoundedBound>,
+    interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
+) -> Result<Certified, BoundsError> {
+    certify_fast_then_interval(outcome()?, required, fast, interval)
 }
 
 /// The interval path of [`certify_fast_then_interval`], kept out of line: it is rarely taken,
@@ -795,62 +817,123 @@ fn certify_by_interval<S: EnclosedBound>(
     })
 }
 
-/// The error-bound path of [`certify_fast_then_interval`]: the largest safe step `hi` when
-/// its enclosure passes, else `hi` moved toward the vertex by the number of ulps that the
-/// bound's slope predicts for the shortfall, enlarged by 1/8 and 2 ulps, when that passes (two
-/// evaluations and no search). The error-bound enclosure is wider than the interval one, so
-/// the move is longer than the interval path's (about twice as many ulps, ≲ 1e-14 relative).
-/// `None` when neither passes: the caller then searches in interval arithmetic.
+/// The common case of every certified step with an error-bound enclosure: a feasible safe
+/// interval (`None` when the outcome is anything else) whose largest step, or that step
+/// moved toward the vertex as [`certify_predicted`] predicts, the error-bound enclosure `fast`
+/// certifies. `None` when any of these fails; the caller then computes the outcome again and
+/// certifies it in full ([`certify_out_of_line`]).
+///
+/// Taking the interval as an `Option` of plain numbers, rather than a [`StepOutcome`], lets
+/// the step functions compute it with the `feasible_*` companions of their solvers, which
+/// return no error values; inlined, the interval then stays in registers and the certified
+/// step is written once, which is most of what makes this path cheap.
 #[inline(always)]
-fn certify_predicted(
-    bound: &RoundedBound,
-    outcome: StepOutcome,
+fn certify_feasible(
+    interval: Option<SafeInterval>,
+    fast: impl FnOnce() -> Option<RoundedBound>,
     required: f64,
-) -> Option<Certified> {
-    let s = match outcome {
-        StepOutcome::Feasible(s) => s,
-        StepOutcome::Infeasible { vertex, .. } => {
-            return Some(Certified::Infeasible {
-                step: vertex,
-                bound: bound.enclose(vertex),
-            });
-        }
-        StepOutcome::ZeroGradient { .. } | StepOutcome::BelowNoise => return None,
-    };
-    let first = bound.enclose(s.hi);
-    let (step, enclosure, ulps_moved) = if first.lo() >= required {
-        (s.hi, first, 0)
-    } else {
-        let (from, to) = (ordered_key(s.hi), ordered_key(s.vertex));
-        let toward = |n: u64| {
-            let n = n as i64;
-            from_ordered_key(if to < from { from - n } else { from + n })
-        };
-        let ulp = (toward(1) - s.hi).abs();
-        // the shortfall is positive, so `predicted` is ≥ 0, +∞ or NaN; 2⁵² bounds the cast
-        let predicted = (required - first.lo()) / (bound.slope(s.hi)?.abs() * ulp);
-        if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
-            return None;
-        }
-        // below 2⁵³ the conversion through i64 is exact and branch-free
-        let n = (predicted * 1.125 + 2.0) as i64 as u64;
-        if n > from.abs_diff(to) {
-            return None;
-        }
-        let x = toward(n);
-        let e = bound.enclose(x);
-        if e.lo() < required {
-            return None;
-        }
-        (x, e, n)
-    };
-    Some(Certified::Step(CertifiedStep {
+) -> Option<CertifiedStep> {
+    let s = interval?;
+    let bound = fast()?;
+    let (step, enclosure, ulps_moved) =
+        certify_predicted(&bound, s.hi, s.vertex, s.c_max, required)?;
+    Some(CertifiedStep {
         step,
         bound: enclosure,
         ulps_moved,
         interval: s,
         by_error_bound: true,
-    }))
+    })
+}
+
+/// The error-bound certificate of the largest safe step `hi` of a feasible outcome with the
+/// given vertex and C_max: (step, enclosure, ulps moved). The step is `hi` when its enclosure
+/// passes, else `hi` moved toward the vertex by the number of ulps that the bound's slope
+/// predicts for the shortfall, enlarged by 1/8 and 2 ulps, when that passes (two evaluations
+/// and no search). The error-bound enclosure is wider than the interval one, so the move is
+/// longer than the interval path's (about twice as many ulps, ≲ 1e-14 relative). `None` when
+/// neither passes: the caller then searches in interval arithmetic.
+#[inline(always)]
+fn certify_predicted(
+    bound: &RoundedBound,
+    hi: f64,
+    vertex: f64,
+    c_max: f64,
+    required: f64,
+) -> Option<(f64, Interval, u64)> {
+    // The move predicted from the coefficients and `hi` alone (plus two ulps), evaluated
+    // beside `hi` itself: `hi` is a root of p(x) = C, so its own enclosure almost never
+    // reaches C, and the moved step is then ready without waiting for that evaluation.
+    let key = ordered_key(hi);
+    let ulp = hi - from_ordered_key(key.saturating_sub(1));
+    let moved = hi - (bound.predicted_move(hi, c_max, required) + 2.0 * ulp);
+    let first = bound.enclose(hi);
+    if first.lo() >= required {
+        return Some((hi, first, 0));
+    }
+    if moved >= vertex && moved < hi {
+        let e = bound.enclose(moved);
+        if e.lo() >= required {
+            return Some((moved, e, key.abs_diff(ordered_key(moved))));
+        }
+    }
+    certify_from_shortfall(*bound, hi, vertex, required, first.lo())
+}
+
+/// The last attempt of [`certify_predicted`]: `hi` moved toward `vertex` by the shortfall of
+/// the lower end `first_lo` of its own enclosure over the bound's slope, enlarged by 1/8 and
+/// 2 ulps (kept out of line: rarely taken).
+#[cold]
+#[inline(never)]
+fn certify_from_shortfall(
+    bound: RoundedBound,
+    hi: f64,
+    vertex: f64,
+    required: f64,
+    first_lo: f64,
+) -> Option<(f64, Interval, u64)> {
+    let (from, to) = (ordered_key(hi), ordered_key(vertex));
+    let toward = |n: u64| {
+        let n = n as i64;
+        from_ordered_key(if to < from { from - n } else { from + n })
+    };
+    let ulp = (toward(1) - hi).abs();
+    // the shortfall is positive, so `predicted` is ≥ 0, +∞ or NaN; 2⁵² bounds the cast
+    let predicted = (required - first_lo) / (bound.slope(hi)?.abs() * ulp);
+    if predicted.partial_cmp(&4_503_599_627_370_496.0) != Some(std::cmp::Ordering::Less) {
+        return None;
+    }
+    // below 2⁵³ the conversion through i64 is exact and branch-free
+    let n = (predicted * 1.125 + 2.0) as i64 as u64;
+    if n > from.abs_diff(to) {
+        return None;
+    }
+    let x = toward(n);
+    let e = bound.enclose(x);
+    (e.lo() >= required).then_some((x, e, n))
+}
+
+/// The common tail of the certified high-probability steps: [`certify_feasible`] on the
+/// feasible interval of `bound`, else the full path on its outcome
+/// ([`hp::safe_step_or_below_noise`]).
+#[inline(always)]
+fn certify_high_probability<S: EnclosedBound>(
+    bound: Option<hp::HighProbabilityBound>,
+    required: f64,
+    form: HpForm,
+    fast: impl FnOnce() -> Option<RoundedBound> + Copy,
+    interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
+) -> Result<Certified, BoundsError> {
+    let feasible = bound.and_then(|b| b.feasible_step(required, form));
+    if let Some(step) = certify_feasible(feasible, fast, required) {
+        return Ok(Certified::Step(step));
+    }
+    certify_out_of_line(
+        required,
+        move || hp::safe_step_or_below_noise(bound, required, form),
+        fast,
+        interval,
+    )
 }
 
 /// The parabola a·x − b·x² with a = g², b = k·g² (Theorems 4.2, 4.3) in rounded `f64`.
@@ -902,11 +985,15 @@ pub fn v_safe_step(
     finite("required", required)?;
     let cc = constants::c(k, sigma)?;
     let n = inf_norm(grad_v);
-    let outcome = v_update::safe_step_with_norm(cc, n, required)?;
-    certify_fast_then_interval(
-        outcome,
+    let fast = move || squared_parabola(n, rounding::c(k, sigma, cc));
+    let interval = v_update::feasible_with_norm(cc, n, required);
+    if let Some(step) = certify_feasible(interval, fast, required) {
+        return Ok(Certified::Step(step));
+    }
+    certify_out_of_line(
         required,
-        move || squared_parabola(n, rounding::c(k, sigma, cc)),
+        move || v_update::safe_step_with_norm(cc, n, required),
+        fast,
         move || Quadratic::v_update(k, sigma, grad_v).map(Some),
     )
 }
@@ -928,11 +1015,15 @@ pub fn w_safe_step_along_j(
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = w_update::safe_step_along_j_with_d(dd, grad_w_j, required)?;
-    certify_fast_then_interval(
-        outcome,
+    let fast = move || squared_parabola(grad_w_j, rounding::d(k, sigma, dd));
+    let interval = w_update::feasible_along_j_with_d(dd, grad_w_j, required);
+    if let Some(step) = certify_feasible(interval, fast, required) {
+        return Ok(Certified::Step(step));
+    }
+    certify_out_of_line(
         required,
-        move || squared_parabola(grad_w_j, rounding::d(k, sigma, dd)),
+        move || w_update::safe_step_along_j_with_d(dd, grad_w_j, required),
+        fast,
         move || Quadratic::w_along_j(k, sigma, grad_w_j).map(Some),
     )
 }
@@ -957,15 +1048,21 @@ pub fn w_safe_step_along_l(
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = w_update::safe_step_along_l_with_d(dd, grad_w_j, grad_w_l, required)?;
     let fast = move || {
         let (j, l) = (Rounded::exact(grad_w_j), Rounded::exact(grad_w_l));
         let b = rounding::d(k, sigma, dd)?.mul(l.mul(l)?)?;
         Some(RoundedBound::parabola(l.mul(j)?, b))
     };
-    certify_fast_then_interval(outcome, required, fast, move || {
-        Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l).map(Some)
-    })
+    let interval = w_update::feasible_along_l_with_d(dd, grad_w_j, grad_w_l, required);
+    if let Some(step) = certify_feasible(interval, fast, required) {
+        return Ok(Certified::Step(step));
+    }
+    certify_out_of_line(
+        required,
+        move || w_update::safe_step_along_l_with_d(dd, grad_w_j, grad_w_l, required),
+        fast,
+        move || Quadratic::w_along_l(k, sigma, grad_w_j, grad_w_l).map(Some),
+    )
 }
 
 /// Certified high-probability v-step, Theorem 4.7 (eq. (4.26)), in the form `form`.
@@ -986,17 +1083,12 @@ pub fn hp_v_safe_step(
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
     let cc = constants::c(k, sigma)?;
-    let outcome = hp::safe_step_or_below_noise(
-        hp::HighProbabilityBound::v_update_with_c(cc, grad_v_hat, eps)?,
-        required,
-        form,
-    )?;
-    certify_fast_then_interval(
-        outcome,
-        required,
-        move || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form),
-        move || HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form),
-    )
+    let bound = hp::HighProbabilityBound::v_update_with_c(cc, grad_v_hat, eps)?;
+    let fast =
+        move || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form);
+    certify_high_probability(bound, required, form, fast, move || {
+        HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form)
+    })
 }
 
 /// Certified high-probability step along ∇̂_w J, Theorem 4.8 (eq. (4.29)).
@@ -1018,17 +1110,11 @@ pub fn hp_w_safe_step_along_j(
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = hp::safe_step_or_below_noise(
-        hp::HighProbabilityBound::w_along_j_with_d(dd, grad_w_j_hat, eps)?,
-        required,
-        form,
-    )?;
-    certify_fast_then_interval(
-        outcome,
-        required,
-        move || corrected_parabola(grad_w_j_hat.abs(), eps, rounding::d(k, sigma, dd), form),
-        move || HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form),
-    )
+    let bound = hp::HighProbabilityBound::w_along_j_with_d(dd, grad_w_j_hat, eps)?;
+    let fast = move || corrected_parabola(grad_w_j_hat.abs(), eps, rounding::d(k, sigma, dd), form);
+    certify_high_probability(bound, required, form, fast, move || {
+        HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form)
+    })
 }
 
 /// Certified high-probability step along ∇̂_w L, Theorem 4.9 (eq. (4.30)); the estimates
@@ -1053,11 +1139,7 @@ pub fn hp_w_safe_step_along_l(
     let (l, el) = grad_w_l_hat;
     finite("required", required)?;
     let dd = constants::d(k, sigma)?;
-    let outcome = hp::safe_step_or_below_noise(
-        hp::HighProbabilityBound::w_along_l_with_d(dd, j, ej, l, el)?,
-        required,
-        form,
-    )?;
+    let bound = hp::HighProbabilityBound::w_along_l_with_d(dd, j, ej, l, el)?;
     let fast = move || {
         let (nj, nl) = (j.abs(), l.abs());
         let (l_hi, j_hi) = (Rounded::sum(nl, el), Rounded::sum(nj, ej));
@@ -1072,7 +1154,7 @@ pub fn hp_w_safe_step_along_l(
             form,
         ))
     };
-    certify_fast_then_interval(outcome, required, fast, move || {
+    certify_high_probability(bound, required, form, fast, move || {
         HpEnclosure::w_along_l(k, sigma, grad_w_j_hat, grad_w_l_hat, form)
     })
 }

@@ -20,7 +20,10 @@
 
 use crate::constants::{TaskConstants, c, d};
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow, non_negative};
-use crate::outcome::{StepOutcome, solve_quadratic, solve_sign_aware};
+use crate::outcome::{
+    SafeInterval, StepOutcome, feasible_interval, feasible_sign_aware, solve_quadratic,
+    solve_sign_aware,
+};
 
 /// Lower- and upper-corrected gradient norms of Section 4.5.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -348,6 +351,24 @@ impl HighProbabilityBound {
                 solve_quadratic(self.direction * self.linear_lower, self.quadratic, required)
             }
             HpForm::SignAware => solve_sign_aware(
+                self.direction,
+                self.linear_lower,
+                self.linear_upper,
+                self.quadratic,
+                required,
+            ),
+        }
+    }
+
+    /// The interval of [`Self::safe_step`] when it returns a feasible one, else `None`
+    /// (`outcome::feasible_interval`).
+    #[inline(always)]
+    pub(crate) fn feasible_step(&self, required: f64, form: HpForm) -> Option<SafeInterval> {
+        match form {
+            HpForm::Thesis => {
+                feasible_interval(self.direction * self.linear_lower, self.quadratic, required)
+            }
+            HpForm::SignAware => feasible_sign_aware(
                 self.direction,
                 self.linear_lower,
                 self.linear_upper,

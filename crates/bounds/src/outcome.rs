@@ -129,8 +129,16 @@ impl StepOutcome {
 /// Vertex a/(2b) and maximum a²/(4b) of a·x − b·x² (b > 0), the single place where every
 /// module computes them, so that a C_max reported by one function is accepted by another.
 pub(crate) fn vertex_and_c_max(a: f64, b: f64) -> Result<(f64, f64), BoundsError> {
-    let vertex = no_overflow("step-size vertex", a / (2.0 * b))?;
-    Ok((vertex, no_overflow("C_max", a * vertex / 2.0)?))
+    let (vertex, c_max) = vertex_and_c_max_unchecked(a, b);
+    no_overflow("step-size vertex", vertex)?;
+    Ok((vertex, no_overflow("C_max", c_max)?))
+}
+
+/// [`vertex_and_c_max`] without the overflow checks.
+#[inline(always)]
+fn vertex_and_c_max_unchecked(a: f64, b: f64) -> (f64, f64) {
+    let vertex = a / (2.0 * b);
+    (vertex, a * vertex / 2.0)
 }
 
 /// C_max = a²/(4b) of a·x − b·x², 0 when a = b = 0 (zero gradient).
@@ -153,6 +161,7 @@ const ROUNDING_SLACK: f64 = 8.0 * f64::EPSILON;
 /// C/b) so that both end points are accurate even when |C| ≪ C_max. A requirement above
 /// C_max by at most 8 ulps (rounding, e.g. C_max computed by another formula) is treated as
 /// C = C_max.
+#[inline]
 pub(crate) fn solve_quadratic(a: f64, b: f64, required: f64) -> Result<StepOutcome, BoundsError> {
     no_overflow("bound coefficient", a)?;
     no_overflow("bound coefficient", b)?;
@@ -171,8 +180,24 @@ pub(crate) fn solve_quadratic(a: f64, b: f64, required: f64) -> Result<StepOutco
     if required > c_max + ROUNDING_SLACK * c_max.abs() {
         return Ok(StepOutcome::Infeasible { c_max, vertex });
     }
+    let (half, s) = interval_parts(a, b, vertex, c_max, required);
+    no_overflow("safe-step interval", half)?;
+    Ok(StepOutcome::Feasible(SafeInterval {
+        lambda: s.lambda.map(|l| no_overflow("lambda", l)).transpose()?,
+        lo: no_overflow("safe-step interval", s.lo)?,
+        hi: no_overflow("safe-step interval", s.hi)?,
+        ..s
+    }))
+}
+
+/// The safe interval of a·x − b·x² ≥ C (b > 0) for its vertex and C_max, with C ≤ C_max(1 +
+/// 8ε) clamped to C_max: the half-width √((C_max − C)/b) and the interval, unchecked (the
+/// callers check that the values are finite). The arithmetic shared by [`solve_quadratic`]
+/// and [`feasible_interval`].
+#[inline(always)]
+fn interval_parts(a: f64, b: f64, vertex: f64, c_max: f64, required: f64) -> (f64, SafeInterval) {
     let required = required.min(c_max);
-    let half = no_overflow("safe-step interval", ((c_max - required) / b).sqrt())?;
+    let half = ((c_max - required) / b).sqrt();
     let (lo, hi) = if a > 0.0 {
         let hi = vertex + half;
         (required / (b * hi), hi)
@@ -186,13 +211,40 @@ pub(crate) fn solve_quadratic(a: f64, b: f64, required: f64) -> Result<StepOutco
     // C = C_max, and many ulps when C_max is subnormal.
     let (lo, hi) = (lo.min(vertex), hi.max(vertex));
     let lambda = (c_max > 0.0).then(|| (1.0 - required / c_max).max(0.0).sqrt());
-    Ok(StepOutcome::Feasible(SafeInterval {
-        c_max,
-        vertex,
-        lambda: lambda.map(|l| no_overflow("lambda", l)).transpose()?,
-        lo: no_overflow("safe-step interval", lo)?,
-        hi: no_overflow("safe-step interval", hi)?,
-    }))
+    (
+        half,
+        SafeInterval {
+            c_max,
+            vertex,
+            lambda,
+            lo,
+            hi,
+        },
+    )
+}
+
+/// The interval of `Ok(StepOutcome::Feasible(_))` when [`solve_quadratic`] returns one, bit
+/// for bit, and `None` for every other outcome (zero gradient, C > C_max, an error). It
+/// returns no error values, so that a caller that inlines it keeps the interval in
+/// registers: the certified steps' fast path, which falls back to [`solve_quadratic`] on
+/// `None`.
+#[inline(always)]
+pub(crate) fn feasible_interval(a: f64, b: f64, required: f64) -> Option<SafeInterval> {
+    // b > 0 finite and a finite; a = b = 0 (zero gradient) fails b > 0
+    if !(a.is_finite() && b > 0.0 && b <= f64::MAX && required.is_finite()) {
+        return None;
+    }
+    let (vertex, c_max) = vertex_and_c_max_unchecked(a, b);
+    if !(vertex.is_finite() && c_max.is_finite()) || required > c_max + ROUNDING_SLACK * c_max.abs()
+    {
+        return None;
+    }
+    let (half, s) = interval_parts(a, b, vertex, c_max, required);
+    let finite = half.is_finite()
+        && s.lo.is_finite()
+        && s.hi.is_finite()
+        && s.lambda.is_none_or(f64::is_finite);
+    finite.then_some(s)
 }
 
 /// Solves the sign-aware high-probability inequality.
@@ -211,13 +263,26 @@ pub(crate) fn solve_sign_aware(
         StepOutcome::Feasible(s) => s,
         other => return Ok(flip(other, sign)),
     };
+    let (t_opposite, s) = sign_aware_parts(sign, favoured, a_minus, b, required);
+    no_overflow("safe-step interval", t_opposite)?;
+    Ok(StepOutcome::Feasible(s))
+}
+
+/// The sign-aware interval from the favoured side's interval, and the opposite side's
+/// largest step t (unchecked: 0 when C ≥ 0). The arithmetic shared by [`solve_sign_aware`]
+/// and [`feasible_sign_aware`].
+#[inline(always)]
+fn sign_aware_parts(
+    sign: f64,
+    favoured: SafeInterval,
+    a_minus: f64,
+    b: f64,
+    required: f64,
+) -> (f64, SafeInterval) {
     let (t_lo, t_hi) = (favoured.lo.max(0.0), favoured.hi);
     let t_opposite = if required < 0.0 {
         // root of b t² + a_minus t + C = 0 on t ≥ 0, written without cancellation
-        no_overflow(
-            "safe-step interval",
-            -2.0 * required / (a_minus + (a_minus * a_minus - 4.0 * b * required).sqrt()),
-        )?
+        -2.0 * required / (a_minus + (a_minus * a_minus - 4.0 * b * required).sqrt())
     } else {
         0.0
     };
@@ -231,13 +296,31 @@ pub(crate) fn solve_sign_aware(
     } else {
         (-hi_t, -lo_t)
     };
-    Ok(StepOutcome::Feasible(SafeInterval {
-        c_max: favoured.c_max,
-        vertex: sign * favoured.vertex,
-        lambda: favoured.lambda,
-        lo,
-        hi,
-    }))
+    (
+        t_opposite,
+        SafeInterval {
+            c_max: favoured.c_max,
+            vertex: sign * favoured.vertex,
+            lambda: favoured.lambda,
+            lo,
+            hi,
+        },
+    )
+}
+
+/// [`feasible_interval`] for [`solve_sign_aware`]: its interval when it returns one, bit for
+/// bit, else `None`.
+#[inline(always)]
+pub(crate) fn feasible_sign_aware(
+    sign: f64,
+    a_plus: f64,
+    a_minus: f64,
+    b: f64,
+    required: f64,
+) -> Option<SafeInterval> {
+    let favoured = feasible_interval(a_plus, b, required)?;
+    let (t_opposite, s) = sign_aware_parts(sign, favoured, a_minus, b, required);
+    t_opposite.is_finite().then_some(s)
 }
 
 /// Expresses a non-feasible outcome of the favoured direction in signed steps.

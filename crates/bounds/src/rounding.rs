@@ -256,6 +256,19 @@ impl RoundedBound {
         }
     }
 
+    /// The predicted distance from a root x of p(x) = C toward the vertex at which the
+    /// enclosure's lower end reaches C: the error bound's factor plus 4u (for the rounding of
+    /// the root itself) times the size of the terms |a·x| + b·x², enlarged by 1/8, over the
+    /// slope at the root, |p′(x)| = 2√(b·(C_max − C)). The slope comes from the coefficients
+    /// alone, so the processor computes it beside the step rather than after it. Only a
+    /// prediction: the caller evaluates the enclosure at the moved step. +∞ or NaN when
+    /// C ≥ C_max.
+    #[inline(always)]
+    pub(crate) fn predicted_move(&self, x: f64, c_max: f64, required: f64) -> f64 {
+        let per_size = (self.margin + 4.0 * U) * 0.5625 / (self.b * (c_max - required)).sqrt();
+        ((x * self.linear(x)).abs() + x * x * self.b) * per_size
+    }
+
     /// The rare cases of [`Self::enclose`]: p(0) = 0, and the widened interval evaluation.
     #[cold]
     #[inline(never)]

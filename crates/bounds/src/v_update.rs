@@ -5,7 +5,9 @@
 
 use crate::constants::{TaskConstants, c};
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow};
-use crate::outcome::{StepOutcome, quadratic_c_max, solve_quadratic};
+use crate::outcome::{
+    SafeInterval, StepOutcome, feasible_interval, quadratic_c_max, solve_quadratic,
+};
 
 /// The step size of maximal guaranteed improvement, α* = 1/(2c) (Theorem 4.2).
 ///
@@ -147,4 +149,12 @@ pub(crate) fn safe_step_with_norm(
 ) -> Result<StepOutcome, BoundsError> {
     let n2 = no_overflow("||grad_v||^2", n * n)?;
     solve_quadratic(n2, cc * n2, required)
+}
+
+/// The interval of [`safe_step_with_norm`] when it returns a feasible one, else `None`
+/// ([`feasible_interval`]).
+#[inline(always)]
+pub(crate) fn feasible_with_norm(cc: f64, n: f64, required: f64) -> Option<SafeInterval> {
+    let n2 = n * n;
+    feasible_interval(n2, cc * n2, required)
 }

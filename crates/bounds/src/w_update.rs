@@ -7,7 +7,9 @@
 
 use crate::constants::{TaskConstants, d};
 use crate::error::{BoundsError, finite, no_overflow};
-use crate::outcome::{StepOutcome, quadratic_c_max, solve_quadratic};
+use crate::outcome::{
+    SafeInterval, StepOutcome, feasible_interval, quadratic_c_max, solve_quadratic,
+};
 
 /// β* = 1/(2d), the step of maximal guaranteed improvement along ∇_w J (Theorem 4.3).
 ///
@@ -115,6 +117,18 @@ pub(crate) fn safe_step_along_j_with_d(
 ) -> Result<StepOutcome, BoundsError> {
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
     solve_quadratic(g2, dd * g2, required)
+}
+
+/// The interval of [`safe_step_along_j_with_d`] when it returns a feasible one, else `None`
+/// ([`feasible_interval`]).
+#[inline(always)]
+pub(crate) fn feasible_along_j_with_d(
+    dd: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Option<SafeInterval> {
+    let g2 = grad_w_j * grad_w_j;
+    feasible_interval(g2, dd * g2, required)
 }
 
 /// The lower bound of Theorem 4.5 for the step Δw = β ∇_w L (β of either sign).
@@ -231,4 +245,16 @@ pub(crate) fn safe_step_along_l_with_d(
     let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
     let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
     solve_quadratic(lj, dd * l2, required)
+}
+
+/// The interval of [`safe_step_along_l_with_d`] when it returns a feasible one, else `None`
+/// ([`feasible_interval`]).
+#[inline(always)]
+pub(crate) fn feasible_along_l_with_d(
+    dd: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Option<SafeInterval> {
+    feasible_interval(grad_w_l * grad_w_j, dd * (grad_w_l * grad_w_l), required)
 }

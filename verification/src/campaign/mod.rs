@@ -74,6 +74,10 @@ pub struct FormTally {
     pub undecided: u64,
     /// Returned enclosures that do not contain the exact bound (must be 0).
     pub enclosure_failures: u64,
+    /// Certified outcomes that do not carry the `f64` outcome of the same inputs bit for bit
+    /// (the safe interval of a certified step, the vertex of an infeasible or uncertifiable
+    /// requirement; must be 0).
+    pub outcome_mismatches: u64,
     /// Feasible requirements that no `f64` step could certify.
     pub uncertifiable: u64,
     /// Certified steps that had to move from the computed step.
@@ -97,6 +101,7 @@ impl FormTally {
         self.by_interval += o.by_interval;
         self.undecided += o.undecided;
         self.enclosure_failures += o.enclosure_failures;
+        self.outcome_mismatches += o.outcome_mismatches;
         self.uncertifiable += o.uncertifiable;
         self.moved += o.moved;
         if o.max_ulps > self.max_ulps {
@@ -108,9 +113,13 @@ impl FormTally {
         }
     }
 
-    /// Whether every certified step was proven safe and every enclosure held.
+    /// Whether every certified step was proven safe, every enclosure held and every certified
+    /// outcome carried its `f64` outcome.
     pub fn clean(&self) -> bool {
-        self.certified_violations == 0 && self.undecided == 0 && self.enclosure_failures == 0
+        self.certified_violations == 0
+            && self.undecided == 0
+            && self.enclosure_failures == 0
+            && self.outcome_mismatches == 0
     }
 }
 
@@ -598,6 +607,15 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     let Some((required, uncertified, certified)) = outcomes(form, c, &k) else {
         return;
     };
+    if !carries(&uncertified, &certified) {
+        t.outcome_mismatches += 1;
+        if t.counterexample.is_none() {
+            t.counterexample = Some(format!(
+                "certified outcome does not carry the f64 outcome: case {index} {c:?}, \
+                 f64 {uncertified:?}, certified {certified:?}"
+            ));
+        }
+    }
     let cc = Mp::f(required);
     if let StepOutcome::Feasible(s) = uncertified
         && let Some(b) = exact_bound(form, c, ex, s.hi)
@@ -661,6 +679,39 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
             enclosure.lo(),
             enclosure.hi()
         ));
+    }
+}
+
+/// Whether `certified` carries the `f64` outcome `uncertified` of the same inputs bit for bit:
+/// a certified step its safe interval, an uncertifiable requirement the interval's vertex, an
+/// infeasible one its vertex, and the same zero-gradient and below-noise outcomes. The fast
+/// path computes the interval apart from the `f64` step function (`feasible_*` in
+/// `sepg-bounds`); this is where the two are compared.
+fn carries(uncertified: &StepOutcome, certified: &Certified) -> bool {
+    let same = |x: f64, y: f64| x.to_bits() == y.to_bits();
+    match (uncertified, certified) {
+        (StepOutcome::Feasible(s), Certified::Step(st)) => {
+            let t = st.interval;
+            same(s.c_max, t.c_max)
+                && same(s.vertex, t.vertex)
+                && same(s.lo, t.lo)
+                && same(s.hi, t.hi)
+                && match (s.lambda, t.lambda) {
+                    (Some(x), Some(y)) => same(x, y),
+                    (None, None) => true,
+                    _ => false,
+                }
+        }
+        (StepOutcome::Feasible(s), Certified::Uncertifiable { step, .. }) => same(s.vertex, *step),
+        (StepOutcome::Infeasible { vertex, .. }, Certified::Infeasible { step, .. }) => {
+            same(*vertex, *step)
+        }
+        (
+            StepOutcome::ZeroGradient { requirement_met: a },
+            Certified::ZeroGradient { requirement_met: b },
+        ) => a == b,
+        (StepOutcome::BelowNoise, Certified::BelowNoise) => true,
+        _ => false,
     }
 }
 
