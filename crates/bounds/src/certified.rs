@@ -21,7 +21,10 @@
 //! arithmetic, γ_k = k·u/(1 − k·u); the analysis is in docs/THEOREMS.md, "Certified steps"),
 //! and fall back to interval arithmetic when that analysis does not apply or does not certify
 //! a step ([`CertifiedStep::by_error_bound`] says which). The rigorous forms and
-//! [`adaptive_step`] use interval arithmetic only.
+//! [`adaptive_step`] use interval arithmetic only. On the fast path the `f64` safe interval
+//! comes from error-free companions of the solvers (`outcome::feasible_interval` and its
+//! callers), which return it bit for bit or nothing, so that it stays in registers; every other
+//! outcome takes the full path.
 //!
 //! | function | bound | thesis |
 //! |---|---|---|
@@ -537,7 +540,8 @@ pub struct CertifiedStep {
     pub bound: Interval,
     /// How many ulps x was moved from the computed largest step toward the vertex.
     pub ulps_moved: u64,
-    /// The safe interval computed in `f64` (λ, C_max and end points as computed).
+    /// The safe interval computed in `f64` (λ, C_max and end points as computed): bit for bit
+    /// the interval of the uncertified step function for the same inputs.
     pub interval: SafeInterval,
     /// Whether the certificate came from the a-priori rounding-error bound of the `f64`
     /// evaluation (the fast path) rather than from interval arithmetic (docs/THEOREMS.md,
