@@ -1,9 +1,9 @@
 //! The exact-arithmetic campaign for certified safe steps (`sepg_verification::campaign`).
 //!
 //! CI runs `campaign_small` (512 random configurations and the adversarial grid of 1,440,
-//! each in all 13 bound forms: about 15 s of CPU). The full campaign, 10⁶ random configurations
-//! per bound form (about 90 CPU-minutes; run it niced, its running totals go to stderr after
-//! each of 40 blocks, its table to stdout):
+//! each in all 13 bound forms: about 15 s of CPU). The full campaign, 10⁶ random
+//! configurations per bound form (about 72 CPU-minutes, 36 minutes on two idle cores; run it
+//! niced, its running totals go to stderr after each of 40 blocks, its table to stdout):
 //!
 //! ```text
 //! cargo test --release -p sepg-verification --test certified_campaign -- --ignored --nocapture
