@@ -928,16 +928,30 @@ fn certify_high_probability<S: EnclosedBound>(
     fast: impl FnOnce() -> Option<RoundedBound> + Copy,
     interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
 ) -> Result<Certified, BoundsError> {
-    let feasible = bound.and_then(|b| b.feasible_step(required, form));
-    if let Some(step) = certify_feasible(feasible, fast, required) {
-        return Ok(Certified::Step(step));
-    }
-    certify_out_of_line(
+    certify_step(
+        bound.and_then(|b| b.feasible_step(required, form)),
         required,
         move || hp::safe_step_or_below_noise(bound, required, form),
         fast,
         interval,
     )
+}
+
+/// The body of the certified steps with an error-free companion: [`certify_feasible`] on the
+/// companion's interval `feasible`, else, out of line, the full path on the outcome that
+/// `outcome` computes ([`certify_out_of_line`]).
+#[inline(always)]
+fn certify_step<S: EnclosedBound>(
+    feasible: Option<SafeInterval>,
+    required: f64,
+    outcome: impl FnOnce() -> Result<StepOutcome, BoundsError>,
+    fast: impl FnOnce() -> Option<RoundedBound> + Copy,
+    interval: impl FnOnce() -> Result<Option<S>, BoundsError>,
+) -> Result<Certified, BoundsError> {
+    if let Some(step) = certify_feasible(feasible, fast, required) {
+        return Ok(Certified::Step(step));
+    }
+    certify_out_of_line(required, outcome, fast, interval)
 }
 
 /// The parabola a·x − b·x² with a = g², b = k·g² (Theorems 4.2, 4.3) in rounded `f64`.
@@ -991,10 +1005,8 @@ pub fn v_safe_step(
     let n = inf_norm(grad_v);
     let fast = move || squared_parabola(n, rounding::c(k, sigma, cc));
     let interval = v_update::feasible_with_norm(cc, n, required);
-    if let Some(step) = certify_feasible(interval, fast, required) {
-        return Ok(Certified::Step(step));
-    }
-    certify_out_of_line(
+    certify_step(
+        interval,
         required,
         move || v_update::safe_step_with_norm(cc, n, required),
         fast,
@@ -1021,10 +1033,8 @@ pub fn w_safe_step_along_j(
     let dd = constants::d(k, sigma)?;
     let fast = move || squared_parabola(grad_w_j, rounding::d(k, sigma, dd));
     let interval = w_update::feasible_along_j_with_d(dd, grad_w_j, required);
-    if let Some(step) = certify_feasible(interval, fast, required) {
-        return Ok(Certified::Step(step));
-    }
-    certify_out_of_line(
+    certify_step(
+        interval,
         required,
         move || w_update::safe_step_along_j_with_d(dd, grad_w_j, required),
         fast,
@@ -1058,10 +1068,8 @@ pub fn w_safe_step_along_l(
         Some(RoundedBound::parabola(l.mul(j)?, b))
     };
     let interval = w_update::feasible_along_l_with_d(dd, grad_w_j, grad_w_l, required);
-    if let Some(step) = certify_feasible(interval, fast, required) {
-        return Ok(Certified::Step(step));
-    }
-    certify_out_of_line(
+    certify_step(
+        interval,
         required,
         move || w_update::safe_step_along_l_with_d(dd, grad_w_j, grad_w_l, required),
         fast,

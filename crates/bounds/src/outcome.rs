@@ -155,6 +155,12 @@ pub(crate) fn quadratic_c_max(a: f64, b: f64) -> Result<f64, BoundsError> {
 /// Relative slack within which C > C_max is attributed to rounding and treated as C = C_max.
 const ROUNDING_SLACK: f64 = 8.0 * f64::EPSILON;
 
+/// Whether C exceeds C_max by more than the rounding slack: the requirement is infeasible.
+#[inline(always)]
+fn beyond_c_max(required: f64, c_max: f64) -> bool {
+    required > c_max + ROUNDING_SLACK * c_max.abs()
+}
+
 /// Solves a·x − b·x² ≥ C for x (b ≥ 0, all inputs finite).
 ///
 /// Uses the numerically stable pair of roots (the small root from the product of the roots,
@@ -177,7 +183,7 @@ pub(crate) fn solve_quadratic(a: f64, b: f64, required: f64) -> Result<StepOutco
         });
     }
     let (vertex, c_max) = vertex_and_c_max(a, b)?;
-    if required > c_max + ROUNDING_SLACK * c_max.abs() {
+    if beyond_c_max(required, c_max) {
         return Ok(StepOutcome::Infeasible { c_max, vertex });
     }
     let (half, s) = interval_parts(a, b, vertex, c_max, required);
@@ -235,8 +241,7 @@ pub(crate) fn feasible_interval(a: f64, b: f64, required: f64) -> Option<SafeInt
         return None;
     }
     let (vertex, c_max) = vertex_and_c_max_unchecked(a, b);
-    if !(vertex.is_finite() && c_max.is_finite()) || required > c_max + ROUNDING_SLACK * c_max.abs()
-    {
+    if !(vertex.is_finite() && c_max.is_finite()) || beyond_c_max(required, c_max) {
         return None;
     }
     let (half, s) = interval_parts(a, b, vertex, c_max, required);

@@ -113,13 +113,19 @@ impl FormTally {
         }
     }
 
+    /// The failures of every kind: certified violations, undecided comparisons, enclosures
+    /// that miss the exact bound and outcome mismatches.
+    pub fn failures(&self) -> u64 {
+        self.certified_violations
+            + self.undecided
+            + self.enclosure_failures
+            + self.outcome_mismatches
+    }
+
     /// Whether every certified step was proven safe, every enclosure held and every certified
-    /// outcome carried its `f64` outcome.
+    /// outcome carried its `f64` outcome ([`Self::failures`] is 0).
     pub fn clean(&self) -> bool {
-        self.certified_violations == 0
-            && self.undecided == 0
-            && self.enclosure_failures == 0
-            && self.outcome_mismatches == 0
+        self.failures() == 0
     }
 }
 

@@ -45,10 +45,7 @@ fn certified_steps(ctx: &CheckContext<'_>) -> Evaluation {
                 t.form,
                 t.counterexample.clone().unwrap_or_default()
             ),
-            amount: (t.certified_violations
-                + t.undecided
-                + t.enclosure_failures
-                + t.outcome_mismatches) as f64,
+            amount: t.failures() as f64,
         },
         None if certified == 0 => Outcome::Inconclusive {
             reason: "no certified step was drawn".into(),
