@@ -18,6 +18,7 @@ use std::path::Path;
 use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
+use sepg_algo::core::statement::{SelfCheck, Statement};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -297,6 +298,14 @@ pub struct Summary {
     /// algorithms, and from the summaries of older versions, which always did).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub certified_steps: Option<bool>,
+    /// What the run promises about exact J (docs/THEOREMS.md, "Statements over a whole run");
+    /// absent from the summaries of older versions, which promised per iteration only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub statement: Option<Statement>,
+    /// The run's own certified bookkeeping: whether its budget or surplus went below zero
+    /// (absent from the summaries of older versions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub self_check: Option<SelfCheck>,
 }
 
 /// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).

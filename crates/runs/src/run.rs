@@ -313,6 +313,8 @@ fn finish(
         },
         scores: resolved.spec.scores,
         certified_steps: resolved.spec.certified_steps,
+        statement: Some(resolved.checked.statement()),
+        self_check: None,
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     observer.wrote(SUMMARY_FILE);

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::core::error::ConfigError;
 use crate::core::options::{SepgOptions, WDirection};
 use crate::core::state::State;
+use crate::core::statement::Statement;
 
 /// Safety requirement of SEPG (Table 4.1, docs/CONVENTIONS.md §5).
 ///
@@ -442,6 +443,22 @@ impl CheckedConfig {
     pub fn with_certified_steps(mut self, on: bool) -> Self {
         self.certified = on;
         self
+    }
+
+    /// What a run of this configuration promises about exact J, and how firmly
+    /// (docs/THEOREMS.md, "Statements over a whole run").
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, SepgConfig};
+    /// use sepg_algo::core::statement::StatementKind;
+    /// use sepg_mdp::env::Preset;
+    /// let adam = SepgConfig::new(Preset::Lqg.build(), Algorithm::adam(1e-3, 0.0)).check()?;
+    /// assert_eq!(adam.statement().kind, StatementKind::None);
+    /// # Ok::<(), sepg_algo::core::error::ConfigError>(())
+    /// ```
+    pub fn statement(&self) -> Statement {
+        crate::core::statement::classify(self)
     }
 
     /// The state before the first iteration: (v⁰, ln σ⁰), B = B⁰.

@@ -7,3 +7,4 @@ pub mod options;
 pub mod record;
 pub mod seed;
 pub mod state;
+pub mod statement;

@@ -1,0 +1,148 @@
+//! What a run promises about the exact performance J, and how firmly (docs/THEOREMS.md,
+//! "Statements over a whole run").
+//!
+//! Every run records a [`Statement`] in its `summary.json`: the requirement it promises, the
+//! kind of justification ([`StatementKind`]), its scope ([`Scope`]) and the confidence δ, and a
+//! [`SelfCheck`] of its own certified bookkeeping. `sepg audit` judges the run against exact J
+//! by exactly this statement.
+use serde::{Deserialize, Serialize};
+
+use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement};
+
+/// How firmly a run's statement is justified.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StatementKind {
+    /// Proven: every step is certified against a valid bound, every confidence width is
+    /// valid at every batch size under the stated constants, every union bound is taken.
+    Proven,
+    /// The same accounting with confidence widths that hold only asymptotically (Student-t,
+    /// docs/ERRATA.md §14): the stated probability is approximate.
+    Approximate,
+    /// No statement about exact J (point-estimate bookkeeping, ε = 0, SIM-ν, the comparison
+    /// algorithms).
+    None,
+}
+
+/// Over what a statement's probability is taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Scope {
+    /// P(every requirement of every iteration holds) ≥ 1 − δ: one exact violation breaks the
+    /// run's promise.
+    Run,
+    /// Each iteration meets its requirement with probability ≥ 1 − δ (the thesis's reading):
+    /// failures are counted against δ per iteration.
+    Iteration,
+}
+
+/// Which policies the statement covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Covers {
+    /// The exploratory policy only (MI, LB-I, LB-II; ZV, whose deterministic target has no
+    /// curvature bound).
+    Exploratory,
+    /// The exploratory policy and the target (LV).
+    ExploratoryAndTarget,
+    /// Nothing.
+    None,
+}
+
+/// The promise a run makes about exact J, recorded in `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Statement {
+    /// How firmly it is justified.
+    pub kind: StatementKind,
+    /// Whether δ bounds the probability of any failure in the whole run or per iteration.
+    pub scope: Scope,
+    /// The confidence δ ∈ (0, 1); `None` with exact gradients (a certainty) or kind `none`.
+    pub delta: Option<f64>,
+    /// Which policies are covered.
+    pub covers: Covers,
+    /// The requirement, in words (e.g. "J ≥ J(θ⁰) − B⁰ at every point of the run").
+    pub requirement: String,
+    /// Why the statement is not proven (empty when it is).
+    pub reasons: Vec<String>,
+}
+
+/// The run's own certified bookkeeping: a certified surplus or budget below zero means the
+/// run knows it broke its requirement (possible only with point-estimate bookkeeping, or
+/// when a requirement could not be met).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct SelfCheck {
+    /// Whether the run's own budget or surplus went below zero.
+    pub broken: bool,
+    /// The first iteration at which it did.
+    pub first_iteration: Option<u64>,
+    /// The budget or surplus there.
+    pub value: Option<f64>,
+}
+
+impl SelfCheck {
+    /// Records the bookkeeping `value` of `iteration`: the first negative value is kept.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::statement::SelfCheck;
+    /// let mut s = SelfCheck::default();
+    /// s.observe(3, 0.5);
+    /// s.observe(4, -1e-6);
+    /// s.observe(5, -2.0);
+    /// assert!(s.broken);
+    /// assert_eq!((s.first_iteration, s.value), (Some(4), Some(-1e-6)));
+    /// ```
+    pub fn observe(&mut self, iteration: u64, value: f64) {
+        if value < 0.0 && !self.broken {
+            self.broken = true;
+            self.first_iteration = Some(iteration);
+            self.value = Some(value);
+        }
+    }
+}
+
+/// The requirement of `req`, in words, with the initial budget `b0` (Table 4.1 as sepg
+/// states it against exact J).
+fn requirement_text(req: Requirement, b0: f64) -> String {
+    match req {
+        Requirement::Mi => "J never decreases: J(θᵗ⁺¹) ≥ J(θᵗ) at every half-step".into(),
+        Requirement::LbI { .. } => "J(θᵗ) ≥ J(θ⁰) at every point of the run".into(),
+        Requirement::LbII | Requirement::Zv => {
+            format!("J(θᵗ) ≥ J(θ⁰) − B⁰ (B⁰ = {b0}) at every point of the run")
+        }
+        Requirement::Lv => format!(
+            "J(θᵗ) ≥ J(θ⁰) − B⁰ and J(θ_Tᵗ) ≥ J(θ⁰) − B⁰ (B⁰ = {b0}) at every point of the run"
+        ),
+        Requirement::Sim { .. } => "none".into(),
+    }
+}
+
+/// The statement of a checked configuration (see [`CheckedConfig::statement`]).
+pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
+    let cfg = checked.config();
+    let none = |reason: &str| Statement {
+        kind: StatementKind::None,
+        scope: Scope::Iteration,
+        delta: None,
+        covers: Covers::None,
+        requirement: "none".into(),
+        reasons: vec![reason.into()],
+    };
+    let req = match cfg.algorithm {
+        Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => r,
+        _ => return none("a comparison algorithm: no safety requirement"),
+    };
+    if matches!(req, Requirement::Sim { .. }) {
+        return none("SIM-ν moves v and w together from one batch: no joint bound");
+    }
+    let mut s = none("requirements built on estimated J (the thesis's bookkeeping, Sec 4.4.4)");
+    s.requirement = requirement_text(req, cfg.initial_budget);
+    s.covers = match req {
+        Requirement::Lv => Covers::ExploratoryAndTarget,
+        _ => Covers::Exploratory,
+    };
+    if let GradientMode::Sampled { delta } = cfg.gradient {
+        s.delta = Some(delta);
+    }
+    s
+}
