@@ -13,8 +13,8 @@ use clap::ValueEnum;
 
 use crate::error::{Error, Result};
 use crate::spec::{
-    AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, ScoresName, WDirectionName,
-    WStepName,
+    AccountingName, AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, ScheduleName,
+    ScoresName, WDirectionName, WStepName,
 };
 use crate::sweep::{self, Seeds, Shard, SweepFile, SweepOptions, SweepSpec, SweepStats};
 
@@ -125,6 +125,8 @@ impl Setting {
         match self {
             Setting::Default => OptionFlags::default(),
             Setting::ThesisCode => OptionFlags {
+                accounting: Some(AccountingName::Estimated),
+                schedule: Some(ScheduleName::Iteration),
                 confidence: Some(ConfidenceName::None),
                 w_direction: Some(WDirectionName::PlugIn),
                 reference_batch: Some(0),
@@ -133,6 +135,8 @@ impl Setting {
                 ..OptionFlags::default()
             },
             Setting::PotionLiteral => OptionFlags {
+                accounting: Some(AccountingName::Estimated),
+                schedule: Some(ScheduleName::Iteration),
                 confidence: Some(ConfidenceName::None),
                 w_direction: Some(WDirectionName::Metagradient),
                 lb1_requirement: Some(Lb1Name::Full),
@@ -144,6 +148,8 @@ impl Setting {
                 ..OptionFlags::default()
             },
             Setting::NoConfidence => OptionFlags {
+                accounting: Some(AccountingName::Estimated),
+                schedule: Some(ScheduleName::Iteration),
                 confidence: Some(ConfidenceName::None),
                 reference_batch: Some(0),
                 ..OptionFlags::default()
@@ -206,6 +212,14 @@ pub struct OptionFlags {
     /// Certified safe steps of the SEPG variants [default: true].
     #[cfg_attr(feature = "clap", arg(long = "certified-steps"))]
     pub certified_steps: Option<bool>,
+    /// What SEPG's requirements are built on [default: certified; the thesis settings:
+    /// estimated].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub accounting: Option<AccountingName>,
+    /// How δ is spread over the confidence widths [default: run; the thesis settings:
+    /// iteration].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub schedule: Option<ScheduleName>,
 }
 
 impl OptionFlags {
@@ -230,7 +244,9 @@ impl OptionFlags {
             action_volume,
             psi,
             scores,
-            certified_steps
+            certified_steps,
+            accounting,
+            schedule
         )
     }
 
@@ -259,6 +275,8 @@ impl OptionFlags {
             psi: self.psi,
             scores: self.scores,
             certified_steps: self.certified_steps.filter(|_| sepg),
+            accounting: self.accounting.filter(|_| sepg),
+            schedule: self.schedule.filter(|_| sepg),
             ..RunSpec::default()
         }
     }

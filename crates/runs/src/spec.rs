@@ -11,7 +11,8 @@ use std::path::Path;
 use clap::{Args, ValueEnum};
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::options::{
-    Confidence, ConstantOverrides, Lb1Requirement, SepgOptions, WDirection, WStep,
+    Accounting, Confidence, ConstantOverrides, Lb1Requirement, Schedule as WidthSchedule,
+    SepgOptions, WDirection, WStep,
 };
 use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
@@ -261,6 +262,29 @@ impl ScoresName {
     }
 }
 
+/// What SEPG's requirements are built on, accepted by `--accounting`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum AccountingName {
+    /// Sums of the certified guarantees of the applied steps: every requirement holds
+    /// against exact J on the confidence events.
+    Certified,
+    /// The thesis's bookkeeping with estimated J (Sec 4.4.4): no statement about exact J.
+    Estimated,
+}
+
+/// How δ is spread over a run's confidence statements, accepted by `--schedule`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ScheduleName {
+    /// δ/(T·K) per width: the whole run holds with probability ≥ 1 − δ.
+    Run,
+    /// δ per width (the thesis): a statement per iteration at most.
+    Iteration,
+}
+
 /// LB-I's requirement per half-step, accepted by `--lb1-requirement`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
@@ -505,6 +529,16 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(long = "certified-steps"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub certified_steps: Option<bool>,
+    /// What SEPG's requirements are built on: certified guarantees (a statement about exact
+    /// J) or the thesis's estimated J [default: certified].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accounting: Option<AccountingName>,
+    /// How δ is spread over the confidence widths: over the whole run, or δ per width (the
+    /// thesis) [default: run].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub schedule: Option<ScheduleName>,
 }
 
 macro_rules! overlay_fields {
@@ -521,7 +555,8 @@ impl RunSpec {
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
             estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
             metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
-            reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps)
+            reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps,
+            accounting, schedule)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -650,6 +685,16 @@ impl RunSpec {
             !sepg && self.certified_steps.is_some(),
             "certified-steps",
             &for_algo,
+        )?;
+        reject(
+            !sepg && (self.accounting.is_some() || self.schedule.is_some()),
+            "accounting/schedule",
+            &for_algo,
+        )?;
+        reject(
+            self.alternating == Some(true) && self.accounting != Some(AccountingName::Estimated),
+            "alternating",
+            "without accounting estimated",
         )?;
         let naive = algo == AlgoName::SepgNaiveW;
         reject(
@@ -795,6 +840,14 @@ impl RunSpec {
                 0
             },
             overrides,
+            accounting: match self.accounting {
+                Some(AccountingName::Estimated) => Accounting::Estimated,
+                Some(AccountingName::Certified) | None => defaults.accounting,
+            },
+            schedule: match self.schedule {
+                Some(ScheduleName::Iteration) => WidthSchedule::Iteration,
+                Some(ScheduleName::Run) | None => defaults.schedule,
+            },
         })
     }
 
@@ -950,6 +1003,14 @@ impl RunSpec {
             }),
             alternating: Some(o.alternating),
             reference_batch: sampled.then_some(o.reference_batch),
+            accounting: Some(match o.accounting {
+                Accounting::Certified => AccountingName::Certified,
+                Accounting::Estimated => AccountingName::Estimated,
+            }),
+            schedule: sampled.then_some(match o.schedule {
+                WidthSchedule::Run => ScheduleName::Run,
+                WidthSchedule::Iteration => ScheduleName::Iteration,
+            }),
             ..overrides
         }
     }

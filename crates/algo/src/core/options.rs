@@ -11,6 +11,8 @@
 //! | [`SepgOptions::alternating`] | `false` | `true` |
 //! | [`SepgOptions::reference_batch`] | 1000 | 0 |
 //! | [`SepgOptions::overrides`] | none | γ = 0.9 in its script, ψ = 0.53 in d |
+//! | [`SepgOptions::accounting`] | [`Accounting::Certified`] | [`Accounting::Estimated`] |
+//! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
@@ -93,6 +95,49 @@ pub enum Lb1Requirement {
     Full,
 }
 
+/// What the safety requirements are built on (docs/THEOREMS.md, "Statements over a whole
+/// run").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Accounting {
+    /// Certified quantities only: LB-I's surplus and the type-II budget are sums of the
+    /// guaranteed improvements of the steps actually applied (each the certified lower end
+    /// of its bound), rounded down; on the confidence events they are lower bounds of
+    /// J(θᵗ) − J(θ⁰), so every requirement holds against exact J. No estimate of J enters.
+    #[default]
+    Certified,
+    /// The thesis's bookkeeping (Sec 4.4.4): LB-I's J(θ⁰) − Ĵᵗ and the budget's measured
+    /// differences of estimated J (with the reference batch's upper bound Û⁰). Kept for
+    /// reproduction; it carries no statement about exact J.
+    Estimated,
+}
+
+impl Accounting {
+    /// The bookkeeping of summaries written before the option existed.
+    fn legacy() -> Self {
+        Accounting::Estimated
+    }
+}
+
+/// How the confidence δ is spread over the confidence statements of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Schedule {
+    /// Over the whole run: iteration t of T gets δ/T, split evenly over its K scalar
+    /// confidence statements (every component of every estimated gradient a guarantee rests
+    /// on), so that by the union bound P(any statement of the run fails) ≤ δ.
+    #[default]
+    Run,
+    /// Every width at level δ (the thesis): each iteration's requirement holds with
+    /// probability about 1 − δ, not the whole run's.
+    Iteration,
+}
+
+impl Schedule {
+    /// The schedule of summaries written before the option existed.
+    fn legacy() -> Self {
+        Schedule::Iteration
+    }
+}
+
 /// Overrides of the task constants R, M_φ, |A|, γ and ψ that the bounds use.
 ///
 /// `gamma` also changes the environment's discount, so J itself changes; the others only
@@ -142,6 +187,12 @@ pub struct SepgOptions {
     pub reference_batch: usize,
     /// Overrides of γ, R, M_φ, |A|.
     pub overrides: ConstantOverrides,
+    /// What the requirements are built on.
+    #[serde(default = "Accounting::legacy")]
+    pub accounting: Accounting,
+    /// How δ is spread over the run's confidence statements.
+    #[serde(default = "Schedule::legacy")]
+    pub schedule: Schedule,
 }
 
 impl Default for SepgOptions {
@@ -154,11 +205,30 @@ impl Default for SepgOptions {
             alternating: false,
             reference_batch: 1000,
             overrides: ConstantOverrides::default(),
+            accounting: Accounting::Certified,
+            schedule: Schedule::Run,
         }
     }
 }
 
 impl SepgOptions {
+    /// The defaults with the thesis's bookkeeping: requirements built on estimated J
+    /// ([`Accounting::Estimated`]) and every width at level δ ([`Schedule::Iteration`]).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::{Accounting, Schedule, SepgOptions};
+    /// let o = SepgOptions::estimated();
+    /// assert_eq!((o.accounting, o.schedule), (Accounting::Estimated, Schedule::Iteration));
+    /// ```
+    pub fn estimated() -> Self {
+        SepgOptions {
+            accounting: Accounting::Estimated,
+            schedule: Schedule::Iteration,
+            ..SepgOptions::default()
+        }
+    }
+
     /// Checks the domains of the options that carry numbers.
     ///
     /// # Errors
@@ -187,6 +257,12 @@ impl SepgOptions {
             && !(clip.is_finite() && clip > 0.0)
         {
             return Err(bad("metagradient clip", clip, "(0, inf)"));
+        }
+        if self.alternating && self.accounting == Accounting::Certified {
+            return Err(ConfigError::UnsupportedOption {
+                option: "alternating",
+                reason: "alternating v/w iterations need the estimated accounting",
+            });
         }
         if self.reference_batch == 1 {
             return Err(bad("reference batch", 1.0, "0 or at least 2"));

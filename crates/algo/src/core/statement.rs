@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement};
+use crate::core::options::{Accounting, Confidence, Schedule};
 
 /// How firmly a run's statement is justified.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -107,9 +108,12 @@ fn requirement_text(req: Requirement, b0: f64) -> String {
     match req {
         Requirement::Mi => "J never decreases: J(θᵗ⁺¹) ≥ J(θᵗ) at every half-step".into(),
         Requirement::LbI { .. } => "J(θᵗ) ≥ J(θ⁰) at every point of the run".into(),
-        Requirement::LbII | Requirement::Zv => {
+        Requirement::LbII => {
             format!("J(θᵗ) ≥ J(θ⁰) − B⁰ (B⁰ = {b0}) at every point of the run")
         }
+        Requirement::Zv => format!(
+            "J(θᵗ) ≥ J(θ⁰) − B⁰ (B⁰ = {b0}) at every point of the run; nothing about the deterministic target"
+        ),
         Requirement::Lv => format!(
             "J(θᵗ) ≥ J(θ⁰) − B⁰ and J(θ_Tᵗ) ≥ J(θ⁰) − B⁰ (B⁰ = {b0}) at every point of the run"
         ),
@@ -120,6 +124,7 @@ fn requirement_text(req: Requirement, b0: f64) -> String {
 /// The statement of a checked configuration (see [`CheckedConfig::statement`]).
 pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
     let cfg = checked.config();
+    let opts = &cfg.options;
     let none = |reason: &str| Statement {
         kind: StatementKind::None,
         scope: Scope::Iteration,
@@ -135,14 +140,46 @@ pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
     if matches!(req, Requirement::Sim { .. }) {
         return none("SIM-ν moves v and w together from one batch: no joint bound");
     }
-    let mut s = none("requirements built on estimated J (the thesis's bookkeeping, Sec 4.4.4)");
-    s.requirement = requirement_text(req, cfg.initial_budget);
-    s.covers = match req {
-        Requirement::Lv => Covers::ExploratoryAndTarget,
-        _ => Covers::Exploratory,
-    };
-    if let GradientMode::Sampled { delta } = cfg.gradient {
-        s.delta = Some(delta);
+    if opts.accounting == Accounting::Estimated {
+        let mut s = none("requirements built on estimated J (the thesis's bookkeeping, Sec 4.4.4)");
+        s.requirement = requirement_text(req, cfg.initial_budget);
+        return s;
     }
-    s
+    let mut reasons = Vec::new();
+    let (delta, scope) = match cfg.gradient {
+        GradientMode::Exact => (None, Scope::Run),
+        GradientMode::Sampled { delta } => {
+            match opts.confidence {
+                Confidence::None => {
+                    return none("confidence none: estimates are used as if exact");
+                }
+                Confidence::StudentT { .. } => reasons.push(
+                    "Student-t widths cover only asymptotically (docs/ERRATA.md §14)".to_string(),
+                ),
+            }
+            let scope = match opts.schedule {
+                Schedule::Run => Scope::Run,
+                Schedule::Iteration => Scope::Iteration,
+            };
+            (Some(delta), scope)
+        }
+    };
+    if !checked.certified() {
+        reasons.push("steps are not certified: rounding can break a bound".to_string());
+    }
+    Statement {
+        kind: if reasons.is_empty() {
+            StatementKind::Proven
+        } else {
+            StatementKind::Approximate
+        },
+        scope,
+        delta,
+        covers: match req {
+            Requirement::Lv => Covers::ExploratoryAndTarget,
+            _ => Covers::Exploratory,
+        },
+        requirement: requirement_text(req, cfg.initial_budget),
+        reasons,
+    }
 }

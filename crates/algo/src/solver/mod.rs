@@ -16,13 +16,13 @@
 //! exec.run(3)?;
 //! drop(exec);
 //! assert_eq!(log.records.len(), 3);
-//! // 3 iterations of N = 30, after the reference batches of J(θ⁰) and of the first target
-//! let reference = checked.config().options.reference_batch as u64;
-//! assert_eq!(log.records[2].trajectories, 90 + 2 * reference);
+//! // 3 iterations of N = 30: the certified accounting estimates no J(θ⁰)
+//! assert_eq!(log.records[2].trajectories, 90);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub(crate) mod baseline;
 pub(crate) mod exact;
+pub(crate) mod realise;
 pub mod sampled;
 pub(crate) mod sepg;
 pub mod source;
@@ -33,10 +33,10 @@ use sepg_estimators::GradientSpec;
 use sepg_mdp::env::AnyEnv;
 use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 
-use crate::core::config::{Algorithm, CheckedConfig, GradientMode, check_sampled};
+use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, check_sampled};
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
-use crate::core::options::SepgOptions;
+use crate::core::options::{Schedule, SepgOptions, WStep};
 use crate::core::record::Record;
 use crate::core::state::State;
 use crate::solver::exact::ExactSource;
@@ -81,7 +81,7 @@ impl PolicySolver {
                     cfg.env.clone(),
                     cfg.horizon,
                     cfg.seed,
-                    delta,
+                    width_delta(config, delta),
                     cfg.options.confidence.factor(),
                     cfg.estimator,
                     constants,
@@ -124,6 +124,53 @@ impl PolicySolver {
             source,
             certified: config.certified(),
         })
+    }
+}
+
+/// The number K of scalar confidence statements one iteration of `algorithm` rests on, with
+/// `dims` = (mean parameters l·p, action dimensions l): every component of ∇̂_v J (the v-step
+/// uses ‖·‖∞), every component of ∇̂_w J (the w-coordinate is chosen from the data), l more
+/// for LV's target, and l more for ∇̂_w L when Theorem 4.9's step reads its width.
+/// Comparison algorithms: one gradient of all l·p + l components.
+pub fn statements_per_iteration(
+    algorithm: Algorithm,
+    options: &SepgOptions,
+    dims: (usize, usize),
+) -> usize {
+    let (m, l) = dims;
+    match algorithm {
+        Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => {
+            let naive = matches!(algorithm, Algorithm::SepgNaiveW(_));
+            let target = usize::from(r == Requirement::Lv);
+            let direction = usize::from(!naive && options.w_step == WStep::Theorem49);
+            m + l * (1 + target + direction)
+        }
+        _ => m + l,
+    }
+}
+
+/// The level of each confidence width of a sampled run: δ (schedule `Iteration`) or
+/// δ/(T·K) (schedule `Run`, T iterations of K statements each,
+/// [`statements_per_iteration`]), so that by the union bound the probability that any
+/// width of the run fails is at most δ.
+///
+/// # Formula
+/// ```text
+/// Run:        δ_width = δ / (T · K)
+/// Iteration:  δ_width = δ
+/// ```
+pub fn width_delta(config: &CheckedConfig, delta: f64) -> f64 {
+    let cfg = config.config();
+    match cfg.options.schedule {
+        Schedule::Iteration => delta,
+        Schedule::Run => {
+            let k = statements_per_iteration(
+                cfg.algorithm,
+                &cfg.options,
+                (cfg.v0.len(), cfg.sigma0.len()),
+            );
+            delta / (cfg.iterations as f64 * k as f64)
+        }
     }
 }
 
@@ -202,7 +249,12 @@ impl PolicySolver {
             n: config.n_trajectories,
             dims,
             constants: config.constants,
-            options: SepgOptions::default(),
+            // No iteration count is known here, so δ cannot be spread over a run: every width
+            // is at level δ (per-iteration statements).
+            options: SepgOptions {
+                schedule: Schedule::Iteration,
+                ..SepgOptions::default()
+            },
             source: Box::new(CollectedSource::new(
                 collector,
                 config.seed,

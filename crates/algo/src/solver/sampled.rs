@@ -528,6 +528,8 @@ mod tests {
         };
         for algorithm in algorithms {
             let mut cfg = SepgConfig::new(sepg_mdp::env::Preset::Lqg1d.build(), algorithm);
+            // a collector run knows no iteration count: its widths are at level δ
+            cfg.options.schedule = crate::core::options::Schedule::Iteration;
             cfg.n_trajectories = 60;
             cfg.seed = 9;
             let checked = cfg.clone().check().expect("config");

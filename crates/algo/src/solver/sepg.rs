@@ -1,13 +1,14 @@
 //! One iteration of SEPG (Algorithm 4.3 with the delayed budget updates of Sec 4.4.4).
 use crate::core::config::Requirement;
 use crate::core::error::RunError;
-use crate::core::options::{Lb1Requirement, SepgOptions};
+use crate::core::options::{Accounting, Lb1Requirement, SepgOptions};
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
 use sepg_bounds::budget::{Budget, split_requirement};
 use sepg_bounds::constants::TaskConstants;
 
+use crate::solver::realise::{CoordinateBound, realise};
 use crate::solver::source::{Estimate, GradientSource, Need, Query};
 use crate::solver::steps::{self, Plan};
 
@@ -214,6 +215,9 @@ pub(crate) fn iterate(
         opts,
         certify,
     } = *setup;
+    if opts.accounting == Accounting::Certified {
+        return iterate_certified(source, setup, state);
+    }
     reference(source, req, opts, state)?;
     if opts.alternating {
         return iterate_alternating(source, setup, state);
@@ -515,9 +519,292 @@ fn w_plan(
     }
 }
 
+/// a + g rounded down: a lower bound of the exact sum (the error term of TwoSum decides).
+fn add_down(a: f64, g: f64) -> f64 {
+    let s = a + g;
+    let bb = s - a;
+    let err = (a - (s - bb)) + (g - bb);
+    if err < 0.0 { s.next_down() } else { s }
+}
+
+/// Splits a budget b ≥ 0 into (b − x, x) with x ≈ share·b, both rounded down, so that the two
+/// parts add up to at most b exactly (share ∈ [0, 1]).
+fn split_down(b: f64, share: f64) -> (f64, f64) {
+    if b.is_nan() || b <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let p = share * b;
+    let x = if share.mul_add(b, -p) < 0.0 {
+        p.next_down()
+    } else {
+        p
+    };
+    let x = x.max(0.0);
+    (add_down(b, -x).max(0.0), x)
+}
+
+/// The requirement C = −allowance of a step allowed to lose `allowance` (C = −allowance when
+/// the allowance is positive; a negative allowance, a broken budget, requires an improvement).
+fn allowed(allowance: f64) -> f64 {
+    -allowance
+}
+
+/// The block log and new coordinate values of a plan whose step is certified again at the
+/// change it realises (`realise`), with `bound` the rigorous bound of the moved coordinate.
+/// Returns the log, the guaranteed improvement of the applied change (0 for no change) and
+/// the realised step size (0 for no change).
+fn apply_realised(
+    x: &mut [f64],
+    plan: &Plan,
+    bound: impl FnOnce(usize) -> Result<CoordinateBound, RunError>,
+    required: f64,
+    certify: bool,
+) -> Result<(BlockLog, f64, f64), RunError> {
+    let Plan::Update(s) = plan else {
+        return Ok((BlockLog::from_plan(plan), 0.0, 0.0));
+    };
+    if !certify {
+        x[s.index] += s.delta;
+        return Ok((BlockLog::from_plan(plan), s.guaranteed, s.size));
+    }
+    let b = bound(s.index)?;
+    let x0 = x[s.index];
+    let r = realise(x0, s.delta, &b, required, s.certified == Some(true));
+    x[s.index] = r.value;
+    let moved = r.value - x0;
+    let size = if s.delta == 0.0 {
+        0.0
+    } else {
+        s.size * (moved / s.delta)
+    };
+    let mut log = BlockLog::from_plan(plan);
+    log.size = size;
+    log.guaranteed = Some(r.guaranteed);
+    log.certified = Some(r.meets && !s.infeasible);
+    Ok((log, r.guaranteed, size))
+}
+
+/// ε = max_i ε_i of a gradient.
+fn eps_max(g: &crate::solver::source::Grad) -> f64 {
+    g.eps.iter().fold(0.0, |m: f64, &e| m.max(e))
+}
+
+/// One SEPG iteration with the certified accounting (`Accounting::Certified`,
+/// docs/THEOREMS.md "Statements over a whole run"): `state.budget` holds the certified budget
+/// B = B⁰ + S (LB-I: its surplus), S the sum of the guaranteed improvements of the applied
+/// changes, rounded down. MI requires 0 of each step; LB-I gives the v-step
+/// −(1 − ν)B and the w-step −νB (both from the B at the iteration's start); the type-II
+/// requirements give each step −B of the moment; SIM-ν splits νB / (1 − ν)B. Every step is
+/// certified again at its realised change against a rigorous bound (`realise`), and
+/// its guarantee is added to B, so on the confidence events B ≤ J(θ) − J(θ⁰) + B⁰ at every
+/// point of the run. Estimated J is logged, never used.
+fn iterate_certified(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    state: &mut State,
+) -> Result<Record, RunError> {
+    let Setup {
+        k,
+        req,
+        naive_w,
+        n,
+        opts,
+        certify,
+    } = *setup;
+    let t = state.iteration;
+    let sizes = split(n, req.blocks());
+    let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
+    let sim_nu = match req {
+        Requirement::Sim { nu } => Some(nu),
+        _ => None,
+    };
+    let sim = sim_nu.is_some();
+    let b0 = state.budget;
+    let (cv, cw) = match (req, opts.lb1_requirement) {
+        (Requirement::Mi, _) => (0.0, 0.0),
+        (Requirement::LbI { nu }, Lb1Requirement::Split) => split_down(b0, nu),
+        (Requirement::Sim { nu }, _) => {
+            let (rest, v_share) = split_down(b0, nu);
+            (v_share, rest)
+        }
+        _ => (b0, f64::NAN),
+    };
+    let required_v = allowed(cv);
+
+    let need_v = Need {
+        grad_v: true,
+        grad_wj: sim || req == Requirement::Lv,
+        grad_wl: sim && !naive_w,
+        j_width: false,
+    };
+    let ev = source.estimate(&Query {
+        iteration: t,
+        block: Block::V,
+        v: &state.v,
+        w: Some(&state.w),
+        n: sizes[0],
+        need: need_v,
+    })?;
+    trajectories += ev.trajectories;
+    env_steps += ev.steps;
+    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
+        "the v-block returned no gradient".into(),
+    ))?;
+    let sigma_v = min_sigma(&state.w);
+    let v_plan = steps::v_step(k, sigma_v, grad_v, required_v, certify)?;
+    let mut v_new = state.v.clone();
+    let eps_v = eps_max(grad_v);
+    let bounds = |e: sepg_bounds::BoundsError| RunError::Bounds(e.to_string());
+    let (v_log, g_v, alpha) = apply_realised(
+        &mut v_new,
+        &v_plan,
+        |i| CoordinateBound::mean(k, sigma_v, grad_v.value[i], eps_v).map_err(bounds),
+        required_v,
+        certify,
+    )?;
+    let b1 = add_down(b0, g_v);
+
+    let sigmas = state.sigma();
+    // Target block (LV, ZV, SIM-ν): its J is logged; LV's target is guaranteed from the
+    // budget at the iteration's start (J(θ_T) ≥ J(θᵗ) − B ≥ J(θ⁰) − B⁰).
+    let mut w_target = Some(state.w.clone());
+    let mut j_target = ev.j;
+    if matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    ) {
+        w_target = if req == Requirement::Lv {
+            let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
+                "the v-block returned no w-gradient".into(),
+            ))?;
+            let mut wt = state.w.clone();
+            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, allowed(b0), certify)? {
+                if certify {
+                    let b = CoordinateBound::log_sigma(k, sigmas[h], gwj.value[h], gwj.eps[h])
+                        .map_err(bounds)?;
+                    wt[h] = realise(wt[h], dw, &b, allowed(b0), true).value;
+                } else {
+                    wt[h] += dw;
+                }
+            }
+            Some(wt)
+        } else {
+            None
+        };
+        let et = source.estimate(&Query {
+            iteration: t,
+            block: Block::Target,
+            v: &state.v,
+            w: w_target.as_deref(),
+            n: sizes[1],
+            need: Need::default(),
+        })?;
+        trajectories += et.trajectories;
+        env_steps += et.steps;
+        j_target = et.j;
+    }
+
+    // w-block (SIM-ν: from the v-block's batch).
+    let mut w_new = state.w.clone();
+    let required_w = if cw.is_nan() {
+        allowed(b1)
+    } else {
+        allowed(cw)
+    };
+    let (j_after_v, ew) = if sim {
+        (None, None)
+    } else {
+        let ew = source.estimate(&Query {
+            iteration: t,
+            block: Block::W,
+            v: &v_new,
+            w: Some(&state.w),
+            n: sizes[sizes.len() - 1],
+            need: Need {
+                grad_v: false,
+                grad_wj: true,
+                grad_wl: !naive_w,
+                j_width: false,
+            },
+        })?;
+        trajectories += ew.trajectories;
+        env_steps += ew.steps;
+        (Some(ew.j), Some(ew))
+    };
+    let e_w = ew.as_ref().unwrap_or(&ev);
+    let gj = e_w.grad_wj.as_ref().ok_or(RunError::Estimator(
+        "the w-block returned no w-gradient".into(),
+    ))?;
+    let w_plan = w_plan(setup, &sigmas, e_w, required_w, alpha)?;
+    let (w_log, g_w, _) = apply_realised(
+        &mut w_new,
+        &w_plan,
+        |h| CoordinateBound::log_sigma(k, sigmas[h], gj.value[h], gj.eps[h]).map_err(bounds),
+        required_w,
+        certify,
+    )?;
+    let b2 = add_down(b1, g_w);
+
+    check_finite(&v_new, &w_new, t)?;
+    let row = Row {
+        iteration: t,
+        v: state.v.clone(),
+        w: state.w.clone(),
+        sigma: sigmas,
+        j_exploratory: ev.j,
+        j_after_v,
+        j_target,
+        w_target,
+        budget: b2,
+        required_v: Some(required_v),
+        required_w: Some(required_w),
+        trajectories,
+        steps: env_steps,
+    };
+    let record = record(row, v_log, w_log);
+    state.iteration += 1;
+    state.v = v_new;
+    state.w = w_new;
+    state.budget = b2;
+    state.trajectories = trajectories;
+    state.steps = env_steps;
+    state.last_alpha = Some(alpha);
+    Ok(record)
+}
+
 #[cfg(test)]
 mod tests {
     use super::split;
+
+    #[test]
+    fn add_down_is_a_lower_bound_of_the_exact_sum() {
+        use super::add_down;
+        // 1 + 2⁻⁶⁰ rounds to 1 (below the exact sum): kept; 1 − 2⁻⁶⁰ rounds to 1 (above): moved
+        assert_eq!(add_down(1.0, 2f64.powi(-60)), 1.0);
+        assert_eq!(add_down(1.0, -(2f64.powi(-60))), 1.0f64.next_down());
+        assert_eq!(add_down(0.5, 0.25), 0.75);
+    }
+
+    #[test]
+    fn split_down_parts_add_up_to_at_most_the_budget() {
+        use super::split_down;
+        for (b, share) in [
+            (1.0, 0.1),
+            (0.3, 0.7),
+            (1e-300, 0.5),
+            (7.0, 1.0),
+            (7.0, 0.0),
+        ] {
+            let (a, x) = split_down(b, share);
+            assert!(a >= 0.0 && x >= 0.0);
+            // exact check in two f64 with TwoSum: a + x ≤ b
+            let s = a + x;
+            let bb = s - a;
+            let err = (a - (s - bb)) + (x - bb);
+            assert!(s < b || (s == b && err <= 0.0), "{b} {share}: {a} + {x}");
+        }
+        assert_eq!(split_down(-1.0, 0.5), (0.0, 0.0));
+    }
 
     #[test]
     fn split_is_even_with_remainder_first() {

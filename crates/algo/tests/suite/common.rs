@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests.
 use sepg_algo::core::config::{Algorithm, GradientMode, SepgConfig};
 use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::PolicySolver;
@@ -36,12 +37,22 @@ pub fn lqg1d(clipped: bool) -> AnyEnv {
     }
 }
 
-/// An exact-gradient configuration with σ⁰ and v⁰ = −0.1.
+/// An exact-gradient configuration with σ⁰ and v⁰ = −0.1, with the thesis's bookkeeping
+/// (`SepgOptions::estimated`), whose budget is Definition 4.3's.
 pub fn exact(env: AnyEnv, algorithm: Algorithm, sigma0: f64) -> SepgConfig {
     SepgConfig {
         gradient: GradientMode::Exact,
         sigma0: vec![sigma0],
+        options: SepgOptions::estimated(),
         ..SepgConfig::new(env, algorithm)
+    }
+}
+
+/// `cfg` with the thesis's bookkeeping (`SepgOptions::estimated`).
+pub fn estimated(cfg: SepgConfig) -> SepgConfig {
+    SepgConfig {
+        options: SepgOptions::estimated(),
+        ..cfg
     }
 }
 

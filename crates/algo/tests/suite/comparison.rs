@@ -13,7 +13,7 @@ use sepg_algo::core::record::Record;
 use sepg_mdp::env::AnyEnv;
 use sepg_mdp::oracle::{ClosedFormOracle, ExactOracle, Exploration, Horizon};
 
-use crate::suite::common::{exact, lqg, lqg1d, run, v_star};
+use crate::suite::common::{estimated, exact, lqg, lqg1d, run, v_star};
 
 /// Rounding slack of an exact J comparison (J is O(100), computed to ~1e-13 relative).
 fn slack(j: f64) -> f64 {
@@ -259,10 +259,10 @@ fn lv_and_sim_sanity_exact() {
 /// noisier than the exploratory policy.
 #[test]
 fn lv_and_sim_sanity_sampled() {
-    let cfg = SepgConfig {
+    let cfg = estimated(SepgConfig {
         seed: 5,
         ..SepgConfig::new(lqg(true), Algorithm::Sepg(Requirement::Sim { nu: 0.5 }))
-    };
+    });
     let (records, state) = run(cfg, 3000);
     assert!(records.iter().all(|r| r.j_after_v.is_none()));
     // N per iteration, plus the reference batches of J(θ⁰) and of the first target.
@@ -270,10 +270,10 @@ fn lv_and_sim_sanity_sampled() {
     assert_eq!(records[9].trajectories, 1000 + 2 * reference);
     let err = (state.v[0] - v_star()).abs();
     assert!(err < 0.2, "SIM: |v − v*| = {err}");
-    let cfg = SepgConfig {
+    let cfg = estimated(SepgConfig {
         seed: 5,
         ..SepgConfig::new(lqg(true), Algorithm::Sepg(Requirement::Lv))
-    };
+    });
     let (records, _) = run(cfg, 300);
     for r in &records {
         let wt = r.w_target.as_ref().expect("LV has a stochastic target");

@@ -30,6 +30,7 @@ fn config(algorithm: Algorithm, seed: u64) -> SepgConfig {
         sigma0: vec![0.2],
         initial_budget: 1.0,
         horizon: H,
+        options: SepgOptions::estimated(),
         ..SepgConfig::new(Preset::MountainCar.build(), algorithm)
     }
 }

@@ -38,7 +38,7 @@ fn share(records: &[Record], f: impl Fn(&Record) -> bool) -> f64 {
 /// seed 0, when measured; at least half is asserted).
 #[test]
 fn exploring_w_step_moves_where_theorem_4_9_does_not() {
-    let (records, _) = run(sampled(LB1, 1.0, SepgOptions::default()), 200);
+    let (records, _) = run(sampled(LB1, 1.0, SepgOptions::estimated()), 200);
     assert_eq!(share(&records, |r| r.below_noise_w), 0.0);
     let mut checked = 0;
     for r in records.iter().filter(|r| !r.infeasible_w) {
@@ -53,7 +53,7 @@ fn exploring_w_step_moves_where_theorem_4_9_does_not() {
     assert!(checked > 100);
     let thesis = SepgOptions {
         w_step: WStep::Theorem49,
-        ..SepgOptions::default()
+        ..SepgOptions::estimated()
     };
     let (records, _) = run(sampled(LB1, 1.0, thesis), 200);
     assert!(share(&records, |r| r.below_noise_w) > 0.5);
@@ -63,9 +63,9 @@ fn exploring_w_step_moves_where_theorem_4_9_does_not() {
 /// from the reference trajectories' returns and the one-sided Student-t quantile.
 #[test]
 fn reference_batch_is_an_upper_confidence_bound_on_j0() {
-    let cfg = sampled(LB1, 1.0, SepgOptions::default());
+    let cfg = sampled(LB1, 1.0, SepgOptions::estimated());
     let (records, state) = run(cfg.clone(), 1);
-    let n = SepgOptions::default().reference_batch;
+    let n = SepgOptions::estimated().reference_batch;
     let policy = GaussianPolicy::scalar(-0.1, 0.0).expect("policy");
     let mut returns = Vec::new();
     rollout_returns_into(
@@ -89,7 +89,7 @@ fn reference_batch_is_an_upper_confidence_bound_on_j0() {
     // Without it, J(θ⁰) is the first v-block's estimate and the first requirement is 0.
     let plain = SepgOptions {
         reference_batch: 0,
-        ..SepgOptions::default()
+        ..SepgOptions::estimated()
     };
     let (records, _) = run(sampled(LB1, 1.0, plain), 1);
     assert_eq!(records[0].required_v, Some(0.0));
@@ -104,7 +104,7 @@ fn alternating_lb1_moves_one_block_at_a_time_and_keeps_j0() {
             options: SepgOptions {
                 alternating: true,
                 lb1_requirement,
-                ..SepgOptions::default()
+                ..SepgOptions::estimated()
             },
             ..exact(lqg(true), Algorithm::Sepg(LB1), 1.0)
         };
@@ -126,9 +126,9 @@ fn alternating_lb1_moves_one_block_at_a_time_and_keeps_j0() {
     let cfg = SepgConfig {
         options: SepgOptions {
             alternating: true,
-            ..SepgOptions::default()
+            ..SepgOptions::estimated()
         },
-        ..sampled(Requirement::Mi, 1.0, SepgOptions::default())
+        ..sampled(Requirement::Mi, 1.0, SepgOptions::estimated())
     };
     let (records, _) = run(cfg, 4);
     assert_eq!(records[3].trajectories, 400);
@@ -142,7 +142,7 @@ fn plug_in_direction_is_exact_with_exact_gradients() {
     let plug = SepgConfig {
         options: SepgOptions {
             w_direction: WDirection::PlugIn,
-            ..SepgOptions::default()
+            ..SepgOptions::estimated()
         },
         ..base.clone()
     };
@@ -162,7 +162,7 @@ fn metagradient_direction_matches_its_formula() {
     let cfg = SepgConfig {
         options: SepgOptions {
             w_direction: WDirection::Metagradient { clip: 100.0 },
-            ..SepgOptions::default()
+            ..SepgOptions::estimated()
         },
         ..exact(lqg(true), Algorithm::Sepg(LB1), 1.0)
     };
@@ -201,9 +201,9 @@ fn overrides_reach_the_bounds_and_the_environment() {
                 action_volume: Some(3.0),
                 psi: Some(0.53),
             },
-            ..SepgOptions::default()
+            ..SepgOptions::estimated()
         },
-        ..sampled(LB1, 1.0, SepgOptions::default())
+        ..sampled(LB1, 1.0, SepgOptions::estimated())
     };
     let checked = cfg.check().expect("valid");
     let k = checked.constants();
@@ -222,7 +222,7 @@ fn overrides_reach_the_bounds_and_the_environment() {
 fn options_that_do_not_apply_are_rejected() {
     let alternating = SepgOptions {
         alternating: true,
-        ..SepgOptions::default()
+        ..SepgOptions::estimated()
     };
     let bad = [
         sampled(Requirement::Zv, 1.0, alternating),
@@ -231,7 +231,7 @@ fn options_that_do_not_apply_are_rejected() {
             1.0,
             SepgOptions {
                 confidence: Confidence::StudentT { factor: -1.0 },
-                ..SepgOptions::default()
+                ..SepgOptions::estimated()
             },
         ),
         sampled(
@@ -239,7 +239,7 @@ fn options_that_do_not_apply_are_rejected() {
             1.0,
             SepgOptions {
                 reference_batch: 1,
-                ..SepgOptions::default()
+                ..SepgOptions::estimated()
             },
         ),
         sampled(
@@ -250,7 +250,7 @@ fn options_that_do_not_apply_are_rejected() {
                     gamma: Some(1.0),
                     ..ConstantOverrides::default()
                 },
-                ..SepgOptions::default()
+                ..SepgOptions::estimated()
             },
         ),
         SepgConfig {

@@ -107,7 +107,7 @@ fn thesis_form() -> SepgOptions {
     SepgOptions {
         w_step: WStep::Theorem49,
         reference_batch: 0,
-        ..SepgOptions::default()
+        ..SepgOptions::estimated()
     }
 }
 
@@ -324,6 +324,7 @@ fn one_exact_iteration_recomputed_from_the_oracle() {
             gradient: GradientMode::Exact,
             sigma0: vec![sigma],
             initial_budget: b0,
+            options: SepgOptions::estimated(),
             ..SepgConfig::new(AnyEnv::Lqg(Box::new(env.clone())), alg)
         };
         let k: TaskConstants = *cfg.clone().check().expect("valid").constants();

@@ -28,6 +28,7 @@
 use approx::abs_diff_eq;
 use rayon::prelude::*;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use sepg_mdp::env::{AnyEnv, LqgEnv};
@@ -186,6 +187,7 @@ fn config(alg: Algorithm, gradient: GradientMode) -> SepgConfig {
         gradient,
         sigma0: vec![SIGMA0],
         seed: 12,
+        options: SepgOptions::estimated(),
         ..SepgConfig::new(AnyEnv::Lqg(Box::new(LqgEnv::thesis())), alg)
     }
 }

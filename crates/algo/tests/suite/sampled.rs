@@ -6,13 +6,13 @@
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_mdp::env::AnyEnv;
 
-use crate::suite::common::{lqg, lqg1d, run, v_star};
+use crate::suite::common::{estimated, lqg, lqg1d, run, v_star};
 
 fn final_error(env: &AnyEnv, req: Requirement, seed: u64) -> f64 {
-    let cfg = SepgConfig {
+    let cfg = estimated(SepgConfig {
         seed,
         ..SepgConfig::new(env.clone(), Algorithm::Sepg(req))
-    };
+    });
     let (_, state) = run(cfg, 10_000);
     (state.v[0] - v_star()).abs()
 }
