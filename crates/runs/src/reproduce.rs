@@ -107,7 +107,7 @@ pub enum Setting {
 }
 
 /// ψ of the thesis-era public code's d (Theorem 4.3), rounded up from Lemma A.1's
-/// ψ = 0.52355702….
+/// ψ = 0.52355702…
 const POTION_PSI: f64 = 0.53;
 
 impl Setting {
