@@ -146,8 +146,11 @@ fn corrected(grad_hat: &[f64], eps: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Boun
 /// ```
 ///
 /// The "/2" inside the first norm is kept as printed; it only makes the bound more conservative
-/// than the α‖∇⁻‖₂² of the source. Holds with probability at least (1 − δ)^m when every
-/// |∇_i − ∇̂_i| ≤ ε_i with probability 1 − δ. `eps` holds one width ε_i ≥ 0 per component.
+/// than the α‖∇⁻‖₂² of the source. Holds on the event that every |∇_i − ∇̂_i| ≤ ε_i; when
+/// each of these m events has probability at least 1 − δ, the union bound gives probability
+/// at least 1 − mδ (the (1 − δ)^m of the thesis would need the m components to be
+/// independent, and they are estimated from one batch; docs/ERRATA.md §26). `eps` holds one
+/// width ε_i ≥ 0 per component.
 ///
 /// ```
 /// use sepg_bounds::{constants::{TaskConstants, c}, pirotta::hp_bound};

@@ -70,8 +70,11 @@ const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
 /// z₁ = √(2 − √3),  z₂ = √(2 + √3)          ≈ 1.832 126
 /// ```
 ///
-/// (z − z³)φ(z) is an antiderivative of −(z⁴ − 4z² + 1)φ(z); the sign changes of the
-/// integrand are at ±z₁, ±z₂. Dimensionless; the value is checked against
+/// G(z) = (z − z³)φ(z) is an antiderivative of (z⁴ − 4z² + 1)φ(z): since φ′(z) = −zφ(z),
+/// G′(z) = (1 − 3z²)φ(z) − z(z − z³)φ(z) = (z⁴ − 4z² + 1)φ(z). The polynomial is positive on
+/// [0, z₁), negative on (z₁, z₂) and positive beyond z₂, so with G(0) = G(∞) = 0 the half
+/// line gives (G(z₁) − G(0)) − (G(z₂) − G(z₁)) + (G(∞) − G(z₂)) = 2(G(z₁) − G(z₂)), and the
+/// even integrand doubles it. Dimensionless; the value is checked against
 /// `scripts/gen_gaussian_constants.py` (mpmath, 60 digits).
 ///
 /// ```

@@ -409,7 +409,7 @@ bound_fns! {
     fn budget_split_requirement(required: f64, nu: f64) -> (f64, f64) = budget::split_requirement;
 }
 
-/// ψ = max_{χ ≥ 0} |(χ² − 4χ + 1) e^{−χ/2}| / √(2π) ≈ 0.523557, the constant of Lemma A.1
+/// ψ = max_{χ ≥ 0} |(χ² − 4χ + 1) e^{−χ/2}| / √(2π) ≈ 0.5235570203, the constant of Lemma A.1
 /// bounding the second derivative of a Gaussian density in its log standard deviation.
 #[pyfunction]
 fn constants_psi() -> f64 {

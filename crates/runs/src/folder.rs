@@ -319,7 +319,7 @@ pub struct UsedConstants {
     pub m_phi: f64,
     /// Action-space volume |A|.
     pub action_volume: f64,
-    /// ψ of Lemma A.1 in d (Theorem 4.3): 0.523557 unless overridden (absent from the
+    /// ψ of Lemma A.1 in d (Theorem 4.3): ψ = 0.52355702… unless overridden (absent from the
     /// summaries of older versions, which always used that value).
     #[serde(default = "sepg_bounds::constants::psi")]
     pub psi: f64,

@@ -106,7 +106,8 @@ pub enum Setting {
     NoConfidence,
 }
 
-/// ψ of the thesis-era public code's d (Theorem 4.3), rounded up from 0.523557.
+/// ψ of the thesis-era public code's d (Theorem 4.3), rounded up from Lemma A.1's
+/// ψ = 0.52355702…
 const POTION_PSI: f64 = 0.53;
 
 impl Setting {
@@ -203,7 +204,7 @@ pub struct OptionFlags {
     /// |A| used by the bounds [default: the environment's].
     #[cfg_attr(feature = "clap", arg(long = "action-volume"))]
     pub action_volume: Option<f64>,
-    /// ψ used by the bound of Theorem 4.3 [default: 0.523557].
+    /// ψ used by the bound of Theorem 4.3 [default: Lemma A.1's ψ = 0.52355702…].
     #[cfg_attr(feature = "clap", arg(long))]
     pub psi: Option<f64>,
     /// Policy scores at the raw or at the clipped action [default: raw].

@@ -513,8 +513,9 @@ pub struct RunSpec {
     )]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub action_volume: Option<f64>,
-    /// ψ of Lemma A.1 used by the bound of Theorem 4.3 [default: 0.523557; the thesis-era
-    /// code used 0.53]; the bounds hold for ψ ≥ 0.523557.
+    /// ψ of Lemma A.1 used by the bound of Theorem 4.3 [default: Lemma A.1's
+    /// ψ = 0.52355702…; the thesis-era code used 0.53]; the bounds hold for any value ≥ ψ
+    /// (0.523557 is below it).
     #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub psi: Option<f64>,

@@ -153,7 +153,8 @@ pub struct ConstantOverrides {
     /// Action-space volume |A|.
     pub action_volume: Option<f64>,
     /// ψ of Lemma A.1 in d (Theorem 4.3); the thesis-era code used 0.53. The bounds hold for
-    /// any value ≥ 0.523557 (`sepg_bounds::constants::psi`).
+    /// any value ≥ ψ = 0.52355702032137… (`sepg_bounds::constants::psi`); a smaller value,
+    /// 0.523557 included, voids them.
     pub psi: Option<f64>,
 }
 
