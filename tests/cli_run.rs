@@ -70,10 +70,10 @@ fn the_readme_example_writes_a_complete_run_folder() {
     for (i, row) in rows.iter().enumerate() {
         assert_eq!(row.len(), header.len());
         assert_eq!(at(row, "iteration"), i.to_string());
-        // N = 100 trajectories per iteration, each exactly H = 20 steps (LQG never terminates),
-        // after ZV's two reference batches of 1000 trajectories (J(θ⁰) and the first target).
-        assert_eq!(at(row, "trajectories"), (2000 + 100 * (i + 1)).to_string());
-        assert_eq!(at(row, "steps"), (40_000 + 2000 * (i + 1)).to_string());
+        // N = 100 trajectories per iteration, each exactly H = 20 steps (LQG never terminates);
+        // the certified accounting estimates no J(θ⁰), so there is no reference batch.
+        assert_eq!(at(row, "trajectories"), (100 * (i + 1)).to_string());
+        assert_eq!(at(row, "steps"), (2000 * (i + 1)).to_string());
         assert_eq!(at(row, "w_target"), "-inf", "ZV's target is deterministic");
     }
     assert_eq!(at(&rows[0], "v"), "-0.1");
@@ -611,4 +611,66 @@ fn resuming_a_finished_run_says_so() {
         std::fs::read(dir.join("summary.json")).expect("summary"),
         summary
     );
+}
+
+/// An exact-gradient SEPG-LV run with the thesis's bookkeeping on `lqg` from σ⁰ = 1 breaks
+/// its own budget (ERRATA §25: −8.6e-5 at iteration 531, computed by the clipped DP): the
+/// run says so on stderr and in summary.json's `self_check`, instead of ending silently.
+/// The same run with the certified accounting keeps its budget (no warning, not broken).
+#[test]
+fn a_run_that_breaks_its_own_budget_says_so() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let run = |accounting: &str, out: &Path| {
+        let out = out.to_str().expect("utf-8 path");
+        sepg(&[
+            "run",
+            "--env",
+            "lqg",
+            "--algo",
+            "sepg-lv",
+            "--gradients",
+            "exact",
+            "--sigma0",
+            "1",
+            "--iterations",
+            "540",
+            "--quiet",
+            "--accounting",
+            accounting,
+            "--out",
+            out,
+        ])
+    };
+    let estimated = tmp.path().join("estimated");
+    let out = run("estimated", &estimated);
+    assert!(out.status.success());
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert!(
+        err.contains("at iteration 531") && err.contains("broke its requirement"),
+        "{err}"
+    );
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(estimated.join("summary.json")).expect("summary"),
+    )
+    .expect("json");
+    assert_eq!(summary["self_check"]["broken"], true);
+    assert_eq!(summary["self_check"]["first_iteration"], 531);
+    let value = summary["self_check"]["value"].as_f64().expect("value");
+    assert!((-9e-5..-8e-5).contains(&value), "{value}");
+    assert_eq!(summary["statement"]["kind"], "none");
+
+    let certified = tmp.path().join("certified");
+    let out = run("certified", &certified);
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(certified.join("summary.json")).expect("summary"),
+    )
+    .expect("json");
+    assert_eq!(summary["self_check"]["broken"], false);
+    assert_eq!(summary["statement"]["kind"], "proven");
 }

@@ -116,5 +116,20 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if !args.quiet {
         println!("{}", summary_line(&dir, &summary));
     }
+    if let Some(line) = self_check_line(&summary) {
+        eprintln!("{line}");
+    }
     Ok(())
+}
+
+/// The warning a run prints, even with `--quiet`, when its own bookkeeping says it broke its
+/// requirement (its budget or surplus went below zero); `None` otherwise.
+pub fn self_check_line(s: &Summary) -> Option<String> {
+    let c = s.self_check.filter(|c| c.broken)?;
+    Some(format!(
+        "warning: the run's own budget went to {:.3e} at iteration {}: it broke its requirement \
+         (summary.json: self_check)",
+        c.value.unwrap_or(f64::NAN),
+        c.first_iteration.unwrap_or(0)
+    ))
 }

@@ -205,6 +205,10 @@ pub struct Tally {
     pub last_j_explore: Option<f64>,
     /// J of the target policy at the last iteration.
     pub last_j_target: Option<f64>,
+    /// The first iteration whose logged budget (the run's own bookkeeping: the certified
+    /// budget or surplus, or the thesis's estimated budget) went below zero.
+    #[serde(default)]
+    pub self_check: SelfCheck,
 }
 
 impl Tally {
@@ -215,6 +219,7 @@ impl Tally {
         self.below_noise_w += u64::from(r.below_noise_w);
         self.last_j_explore = Some(r.j_exploratory);
         self.last_j_target = Some(r.j_target);
+        self.self_check.observe(r.iteration, r.budget);
     }
 }
 

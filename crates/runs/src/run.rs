@@ -314,7 +314,7 @@ fn finish(
         scores: resolved.spec.scores,
         certified_steps: resolved.spec.certified_steps,
         statement: Some(resolved.checked.statement()),
-        self_check: None,
+        self_check: Some(ck.tally.self_check),
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     observer.wrote(SUMMARY_FILE);

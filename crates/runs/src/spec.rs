@@ -1244,6 +1244,7 @@ mod tests {
             quantile_factor: Some(2.0),
             lb1_requirement: Some(Lb1Name::Full),
             alternating: Some(true),
+            accounting: Some(AccountingName::Estimated),
             reference_batch: Some(0),
             gamma: Some(0.9),
             r_max: Some(30.0),
@@ -1259,6 +1260,7 @@ mod tests {
         assert_eq!(o.confidence, Confidence::StudentT { factor: 2.0 });
         assert_eq!(o.lb1_requirement, Lb1Requirement::Full);
         assert!(o.alternating);
+        assert_eq!(o.accounting, Accounting::Estimated);
         assert_eq!(o.reference_batch, 0);
         assert_eq!(once.checked.constants().gamma(), 0.9);
         assert_eq!(once.checked.constants().r_max(), 30.0);

@@ -3,6 +3,7 @@
 
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::solver::PolicySolver;
 use sepg_mdp::env::{AnyEnv, LqgEnv};
@@ -63,6 +64,8 @@ fn run_with_budget(
         horizon: HORIZON,
         v0,
         initial_budget,
+        // the thesis's algorithm as it states it: budgets from measured J (Definition 4.3)
+        options: SepgOptions::estimated(),
         ..base
     };
     let checked = cfg.check().ok()?;

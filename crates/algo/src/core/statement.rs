@@ -5,6 +5,7 @@
 //! kind of justification ([`StatementKind`]), its scope ([`Scope`]) and the confidence δ, and a
 //! [`SelfCheck`] of its own certified bookkeeping. `sepg audit` judges the run against exact J
 //! by exactly this statement.
+use sepg_mdp::env::Environment;
 use serde::{Deserialize, Serialize};
 
 use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement};
@@ -157,16 +158,33 @@ pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
                     "Student-t widths cover only asymptotically (docs/ERRATA.md §14)".to_string(),
                 ),
             }
-            let scope = match opts.schedule {
-                Schedule::Run => Scope::Run,
-                Schedule::Iteration => Scope::Iteration,
-            };
-            (Some(delta), scope)
+            match opts.schedule {
+                Schedule::Run => (Some(delta), Scope::Run),
+                // Per-iteration widths bound MI's per-step requirement at K·δ per iteration
+                // (union over its K statements); the cumulative requirements get nothing.
+                Schedule::Iteration if req == Requirement::Mi => {
+                    let k = crate::solver::statements_per_iteration(
+                        cfg.algorithm,
+                        opts,
+                        (cfg.v0.len(), cfg.sigma0.len()),
+                    );
+                    (Some((k as f64 * delta).min(1.0)), Scope::Iteration)
+                }
+                Schedule::Iteration => {
+                    let mut s = none(
+                        "widths at level δ each (schedule iteration) do not bound a cumulative \
+                         requirement",
+                    );
+                    s.requirement = requirement_text(req, cfg.initial_budget);
+                    return s;
+                }
+            }
         }
     };
     if !checked.certified() {
         reasons.push("steps are not certified: rounding can break a bound".to_string());
     }
+    reasons.extend(assumption_reasons(checked));
     Statement {
         kind: if reasons.is_empty() {
             StatementKind::Proven
@@ -182,4 +200,38 @@ pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
         requirement: requirement_text(req, cfg.initial_budget),
         reasons,
     }
+}
+
+/// Why the assumptions of the statement may fail for `checked`: constants overridden below
+/// the environment's, scores at the clipped action, rewards the environment does not bound.
+fn assumption_reasons(checked: &CheckedConfig) -> Vec<String> {
+    let cfg = checked.config();
+    let env = cfg.env.constants();
+    let o = cfg.options.overrides;
+    let mut reasons = Vec::new();
+    let below = |over: Option<f64>, own: f64| over.is_some_and(|x| x < own);
+    if below(o.r_max, env.r_max)
+        || below(o.m_phi, env.m_phi)
+        || below(o.action_volume, env.action_volume)
+        || o.psi.is_some_and(|p| p < sepg_bounds::constants::psi())
+    {
+        reasons.push(
+            "constants overridden below the environment's: the bounds hold only if they are \
+             true bounds"
+                .to_string(),
+        );
+    }
+    if matches!(cfg.gradient, GradientMode::Sampled { .. })
+        && cfg.score_action == sepg_mdp::rollout::ScoreAction::Clipped
+    {
+        reasons.push("scores at the clipped action: the estimators are biased".to_string());
+    }
+    if matches!(cfg.env, sepg_mdp::env::AnyEnv::MountainCar(_)) {
+        reasons.push(
+            "Mountain Car's reward −0.1a² with the raw action is not bounded by R \
+             (docs/ERRATA.md §19)"
+                .to_string(),
+        );
+    }
+    reasons
 }
