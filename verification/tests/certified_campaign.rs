@@ -37,6 +37,23 @@ fn print(tallies: &[FormTally]) {
             t.outcome_mismatches
         );
     }
+    println!();
+    println!(
+        "| form | rounded updates | violated exactly | realised updates | realised violations | unmet (nothing moved) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for t in tallies {
+        println!(
+            "| {} | {} | {} ({:.1}%) | {} | {} | {} |",
+            t.form,
+            t.raw_updates,
+            t.raw_violations,
+            100.0 * t.raw_violations as f64 / t.raw_updates.max(1) as f64,
+            t.realised,
+            t.realised_violations,
+            t.realised_unmet
+        );
+    }
     for t in tallies {
         println!("{}: largest move {:?}", t.form, t.largest_move);
     }
@@ -67,6 +84,14 @@ fn campaign_small() {
     assert!(
         violated > 100 && moved > 100,
         "violated {violated}, moved {moved}"
+    );
+    // rounding the applied update breaks certified step sizes, and the realised updates are
+    // checked (every form that SEPG applies to one coordinate)
+    let raw: u64 = tallies.iter().map(|t| t.raw_violations).sum();
+    let realised: u64 = tallies.iter().map(|t| t.realised).sum();
+    assert!(
+        raw > 100 && realised > 1000,
+        "raw violations {raw}, realised {realised}"
     );
     // both paths of the certificate are exercised: the a-priori error bound accepts most
     // steps, interval arithmetic takes the rest (rigorous forms, extreme inputs, C near C_max)
@@ -100,13 +125,15 @@ fn campaign_full() {
         }
         let sum = |f: fn(&FormTally) -> u64| tallies.iter().map(f).sum::<u64>();
         eprintln!(
-            "random configurations done: {} of {RANDOM}; certified steps {}, certified violations {}, undecided {}, enclosure failures {}, outcome mismatches {}",
+            "random configurations done: {} of {RANDOM}; certified steps {}, certified violations {}, undecided {}, enclosure failures {}, outcome mismatches {}, realised updates {}, realised violations {}",
             (block(b).end * 256).min(RANDOM),
             sum(|t| t.certified_steps),
             sum(|t| t.certified_violations),
             sum(|t| t.undecided),
             sum(|t| t.enclosure_failures),
-            sum(|t| t.outcome_mismatches)
+            sum(|t| t.outcome_mismatches),
+            sum(|t| t.realised),
+            sum(|t| t.realised_violations)
         );
     }
     merge(&mut tallies, run_adversarial(RANDOM));

@@ -34,6 +34,8 @@ use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{exploring, pirotta, rigorous, v_update, w_update};
 
+use sepg_algo::solver::realise::{CoordinateBound, realise};
+
 use crate::check::splitmix64;
 use mp::{Dyadic, Mp};
 
@@ -88,6 +90,21 @@ pub struct FormTally {
     pub largest_move: Option<String>,
     /// The first failing configuration (lowest case index), if any.
     pub counterexample: Option<String>,
+    /// Certified steps applied to a parameter value as SEPG applies them, x₁ = fl(x₀ + Δ),
+    /// whose realised change x₁ − x₀ is exact in `f64` (the others are not counted).
+    pub raw_updates: u64,
+    /// Of those, the rounded updates whose coordinate bound (`sepg_algo::solver::realise`) at
+    /// the realised change is below C in exact arithmetic: what certifying the step size alone
+    /// leaves open.
+    pub raw_violations: u64,
+    /// Certified steps applied through `sepg_algo::solver::realise` that report meeting C.
+    pub realised: u64,
+    /// Of those, the ones whose realised change is not exact in `f64`, or whose coordinate
+    /// bound at the realised change is below C or its logged guarantee (or undecided) in exact
+    /// arithmetic (must be 0).
+    pub realised_violations: u64,
+    /// Applied updates that report not meeting C (no `f64` change passed: nothing moved).
+    pub realised_unmet: u64,
 }
 
 impl FormTally {
@@ -104,6 +121,11 @@ impl FormTally {
         self.outcome_mismatches += o.outcome_mismatches;
         self.uncertifiable += o.uncertifiable;
         self.moved += o.moved;
+        self.raw_updates += o.raw_updates;
+        self.raw_violations += o.raw_violations;
+        self.realised += o.realised;
+        self.realised_violations += o.realised_violations;
+        self.realised_unmet += o.realised_unmet;
         if o.max_ulps > self.max_ulps {
             self.max_ulps = o.max_ulps;
             self.largest_move = o.largest_move;
@@ -114,12 +136,14 @@ impl FormTally {
     }
 
     /// The failures of every kind: certified violations, undecided comparisons, enclosures
-    /// that miss the exact bound and outcome mismatches.
+    /// that miss the exact bound, outcome mismatches and realised updates that break their
+    /// requirement or guarantee.
     pub fn failures(&self) -> u64 {
         self.certified_violations
             + self.undecided
             + self.enclosure_failures
             + self.outcome_mismatches
+            + self.realised_violations
     }
 
     /// Whether every certified step was proven safe, every enclosure held and every certified
@@ -338,6 +362,36 @@ impl Exact {
         let box_term = self.volume.div(&mp::sqrt_2pi().mul(&self.sigma))?;
         let discount = self.gamma.div(&self.one_minus.ldexp(1))?;
         Some(front.mul(&box_term.add(&discount)))
+    }
+
+    /// c on ℝ: c with the box term replaced by max(|A|/(√(2π)σ), K_MU), K_MU = 4e^{−1/2}/√(2π)
+    /// (docs/ERRATA.md §27), the curvature constant of the applied mean-coordinate change.
+    fn c_real_line(&self) -> Option<Mp> {
+        let front = self
+            .r
+            .mul(&self.m.sqr())
+            .div(&self.one_minus.sqr().mul(&self.sigma.sqr()))?;
+        let box_term = self.volume.div(&mp::sqrt_2pi().mul(&self.sigma))?;
+        let k_mu = Mp::int(4).mul(&Mp::f(-0.5).exp()?).div(mp::sqrt_2pi())?;
+        let discount = self.gamma.div(&self.one_minus.ldexp(1))?;
+        Some(front.mul(&box_term.max(&k_mu).add(&discount)))
+    }
+
+    /// The bound of an applied change Δ of one coordinate (`sepg_algo::solver::realise`),
+    /// written here from its statement: Δ·ĝ − |Δ|·ε − c_ℝΔ² for a mean coordinate, the
+    /// rigorous w-bound at ĝ minus |Δ|·ε for a log-σ coordinate, at the exact Δ.
+    fn coordinate(&self, mean: bool, grad: f64, eps: f64, delta: f64) -> Option<Mp> {
+        let d = Mp::f(delta);
+        let slack = Mp::f(delta.abs()).mul(&Mp::f(eps));
+        if mean {
+            Some(
+                d.mul(&Mp::f(grad))
+                    .sub(&slack)
+                    .sub(&self.c_real_line()?.mul(&d.sqr())),
+            )
+        } else {
+            Some(self.rigorous(grad, delta, 1.0)?.sub(&slack))
+        }
     }
 
     /// d(σ) = R/(1−γ)² · (ψ|A|/(2σ) + γ/(1−γ)), Theorem 4.3.
@@ -604,6 +658,98 @@ fn exact_bound(form: usize, c: &Case, ex: &Exact, x: f64) -> Option<Mp> {
     })
 }
 
+/// Parameter values the certified steps are applied to (one per case and form, by index):
+/// from small to large against the steps, so that rounding x₀ + Δ moves the realised change.
+const STARTS: [f64; 4] = [-0.1, -0.693_147_180_559_945_3, 1.0, -123.456];
+
+/// The coordinate change SEPG applies for a certified step of `form` on `c`: (the direction
+/// component that multiplies the step, ĝ of the moved coordinate, its width ε, whether it is a
+/// mean coordinate); `None` for the adaptive step, which moves every coordinate.
+fn applied(form: usize, c: &Case) -> Option<(f64, f64, f64, bool)> {
+    let (j, l) = (c.grad_w_j, c.grad_w_l);
+    let g = c
+        .grad_v
+        .iter()
+        .copied()
+        .fold(0.0_f64, |m, x| if x.abs() > m.abs() { x } else { m });
+    Some(match form {
+        0 => (g, g, 0.0, true),
+        3 | 4 => (g, g, c.eps_v, true),
+        1 | 8 => (j, j, 0.0, false),
+        5 | 10 => (j, j, c.eps_j, false),
+        2 | 9 => (l, j, 0.0, false),
+        6 | 7 | 11 => (l, j, c.eps_j, false),
+        _ => return None,
+    })
+}
+
+/// y − x when it is exact in `f64` (the error term of TwoSum is 0).
+fn exact_change(y: f64, x: f64) -> Option<f64> {
+    let s = y - x;
+    let bb = s - y;
+    let err = (y - (s - bb)) + (-x - bb);
+    (err == 0.0 && s.is_finite()).then_some(s)
+}
+
+/// Applies the certified step `step` of `form` at x₀ = STARTS[(index + form) mod 4], rounded
+/// as a run rounds it and through `sepg_algo::solver::realise`, and checks both in exact
+/// arithmetic.
+#[allow(clippy::too_many_arguments)]
+fn tally_applied(
+    t: &mut FormTally,
+    form: usize,
+    index: u64,
+    c: &Case,
+    k: &TaskConstants,
+    step: f64,
+    required: f64,
+    ex: &Exact,
+) {
+    let Some((dir, grad, eps, mean)) = applied(form, c) else {
+        return;
+    };
+    let bound = if mean {
+        CoordinateBound::mean(k, c.sigma, grad, eps)
+    } else {
+        CoordinateBound::log_sigma(k, c.sigma, grad, eps)
+    };
+    let Ok(bound) = bound else {
+        return;
+    };
+    let x0 = STARTS[((index + form as u64) % 4) as usize];
+    let delta = step * dir;
+    if !delta.is_finite() {
+        return;
+    }
+    let cc = Mp::f(required);
+    // a log-σ change beyond ±64 is far outside any safe step (e^{64} in the bound); its
+    // exact evaluation would need numbers of e^{|Δ|} bits
+    if let Some(d) = exact_change(x0 + delta, x0).filter(|d| mean || d.abs() <= 64.0)
+        && let Some(b) = ex.coordinate(mean, grad, eps, d)
+    {
+        t.raw_updates += 1;
+        t.raw_violations += u64::from(b.certainly_lt(&cc));
+    }
+    let r = realise(x0, delta, &bound, required, true);
+    if !r.meets {
+        t.realised_unmet += 1;
+        return;
+    }
+    t.realised += 1;
+    let ok = exact_change(r.value, x0)
+        .and_then(|d| ex.coordinate(mean, grad, eps, d))
+        .is_some_and(|b| b.certainly_ge(&cc) && b.certainly_ge(&Mp::f(r.guaranteed)));
+    if !ok {
+        t.realised_violations += 1;
+        if t.counterexample.is_none() {
+            t.counterexample = Some(format!(
+                "realised update breaks C or its guarantee: case {index} {c:?}, x0 {x0:e}, step {step:e}, C {required:e}, x1 {:e}, guaranteed {:e}",
+                r.value, r.guaranteed
+            ));
+        }
+    }
+}
+
 /// Tallies one form on one case.
 fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     t.cases += 1;
@@ -651,6 +797,7 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     }
     match certified {
         Certified::Step(st) => {
+            tally_applied(t, form, index, c, &k, step, required, ex);
             t.certified_steps += 1;
             if st.by_error_bound {
                 t.by_error_bound += 1;

@@ -22,7 +22,7 @@
 //! ```
 pub(crate) mod baseline;
 pub(crate) mod exact;
-pub(crate) mod realise;
+pub mod realise;
 pub mod sampled;
 pub(crate) mod sepg;
 pub mod source;

@@ -28,9 +28,10 @@ use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::interval::Interval;
 use sepg_bounds::rigorous;
 
-/// A rigorous lower bound of J(x₀ + Δ) − J(x₀) for changes Δ of one coordinate.
+/// A rigorous lower bound of J(x₀ + Δ) − J(x₀) for changes Δ of one coordinate (module
+/// docs), valid for every Δ at once on the confidence event of the coordinate's estimate.
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum CoordinateBound {
+pub enum CoordinateBound {
     /// A mean coordinate: Δ·ĝ − |Δ|·ε − c·Δ², c enclosed.
     Mean {
         /// ĝ.
@@ -80,14 +81,12 @@ fn c_real_line(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
 }
 
 impl CoordinateBound {
-    /// The bound of mean coordinate with estimate `grad` ± `eps` at standard deviation
-    /// `sigma` (the smallest σ of the policy, as in Theorem 4.2's c).
-    pub(crate) fn mean(
-        k: &TaskConstants,
-        sigma: f64,
-        grad: f64,
-        eps: f64,
-    ) -> Result<Self, BoundsError> {
+    /// The bound of a mean coordinate with estimate `grad` ± `eps` (the units of ∂J/∂v) at
+    /// standard deviation `sigma` > 0 (the smallest σ of the policy, as in Theorem 4.2's c).
+    ///
+    /// # Errors
+    /// [`BoundsError::OutOfDomain`] for σ not finite and positive.
+    pub fn mean(k: &TaskConstants, sigma: f64, grad: f64, eps: f64) -> Result<Self, BoundsError> {
         Ok(CoordinateBound::Mean {
             grad,
             eps,
@@ -95,8 +94,12 @@ impl CoordinateBound {
         })
     }
 
-    /// The bound of a log-σ coordinate at σ with estimate `grad` ± `eps`.
-    pub(crate) fn log_sigma(
+    /// The bound of a log-σ coordinate at σ > 0 with estimate `grad` ± `eps` (units of
+    /// ∂J/∂w).
+    ///
+    /// # Errors
+    /// The errors of [`RigorousEnclosure::new`] (σ not positive, non-finite inputs).
+    pub fn log_sigma(
         k: &TaskConstants,
         sigma: f64,
         grad: f64,
@@ -108,8 +111,8 @@ impl CoordinateBound {
         })
     }
 
-    /// An enclosure of the bound at the exact change `delta`.
-    pub(crate) fn enclose(&self, delta: f64) -> Interval {
+    /// An enclosure of the bound at the exact change `delta` (units of the coordinate).
+    pub fn enclose(&self, delta: f64) -> Interval {
         if delta == 0.0 {
             return Interval::point(0.0);
         }
@@ -137,13 +140,13 @@ fn exact_difference(y: f64, x: f64) -> Option<f64> {
 
 /// The update of one coordinate that is applied, and the certified lower end of its bound.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Realised {
+pub struct Realised {
     /// The new value of the coordinate.
-    pub(crate) value: f64,
+    pub value: f64,
     /// The lower end of the enclosure of the bound at the realised change.
-    pub(crate) guaranteed: f64,
+    pub guaranteed: f64,
     /// Whether the realised change meets the requirement (`guaranteed ≥ required`).
-    pub(crate) meets: bool,
+    pub meets: bool,
 }
 
 /// Applies x₀ → fl(x₀ + Δ) and certifies the realised change against `bound` for
@@ -151,7 +154,7 @@ pub(crate) struct Realised {
 /// shrunk (x₀ + Δ(1 − 2⁻ʲ) for j = 52, 51, …, 1) until one passes, and no change at all is
 /// the last resort. With `shrink` false (a step that was not certified, e.g. an infeasible
 /// requirement) the rounded update is kept and only its guarantee evaluated.
-pub(crate) fn realise(
+pub fn realise(
     x0: f64,
     delta: f64,
     bound: &CoordinateBound,

@@ -412,7 +412,11 @@ fn certified_accounting_keeps_every_requirement_with_exact_gradients() {
                 ];
                 for (which, g, realised, scale) in blocks {
                     let g = g.unwrap_or(0.0);
-                    let floor = if req == Requirement::Mi { g.max(0.0) } else { g };
+                    let floor = if req == Requirement::Mi {
+                        g.max(0.0)
+                    } else {
+                        g
+                    };
                     if realised < floor - slack(scale) {
                         failed.push(format!(
                             "{alg:?} σ⁰={sigma0} t={t} {which}: realised {realised} < {floor}"
