@@ -207,13 +207,23 @@ impl PolicySolver {
     }
 
     /// Replaces the SEPG options of this solver, e.g. one built by
-    /// [`PolicySolver::with_collector`], which starts from [`SepgOptions::default`] (a
-    /// collector that reproduces the thesis's pseudocode sets `reference_batch` to 0).
+    /// [`PolicySolver::with_collector`], which starts from [`SepgOptions::default`] with
+    /// [`Schedule::Iteration`] (a collector that reproduces the thesis's pseudocode sets
+    /// `reference_batch` to 0).
     ///
     /// # Errors
-    /// As [`SepgOptions::validate`].
+    /// As [`SepgOptions::validate`]; [`ConfigError::UnsupportedOption`] for a schedule other
+    /// than the solver's (its widths are built for it).
     pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
         options.validate()?;
+        if options.schedule != self.options.schedule {
+            // the widths were built for the solver's schedule
+            return Err(ConfigError::UnsupportedOption {
+                option: "schedule",
+                reason: "the schedule is fixed when the solver is built (a collector solver \
+                         knows no iteration count: schedule iteration)",
+            });
+        }
         self.options = options;
         Ok(self)
     }
