@@ -19,16 +19,17 @@
 //!
 //! # Formula
 //! ```text
-//! R' = R (two-sided, b = 0)  or  R/2 (non-positive, b = −R/2);   a_t = γ^t R'
-//! v-component (ψ2):  K_v  = √(8/3) (M_φ/σ) Σ_{t<H} a_t √(t+1)            ≥ ‖g‖_ψ2
-//!                    K'_v = (√(8/3) + 1/√(ln 2)) (M_φ/σ) Σ_{t<H} a_t √(t+1)  ≥ ‖g − Eg‖_ψ2
-//!                    ε_v  = 2 K'_v √(ln(2/δ)/N)
-//! w-component (ψ1):  k_n  = ‖χ²_n − n‖_ψ1 (computed, rounded up)
-//!                    K_w  = Σ_{t<H} a_t k_{t+1}                            ≥ ‖g‖_ψ1
-//!                    K'_w = K_w + min(K_w, Σ_{t<H} a_t √(2(t+1)) / ln 2)   ≥ ‖g − Eg‖_ψ1
-//!                    ε_w  = 2 K'_w √(L)  if L ≤ 1,  K'_w (1 + L) otherwise,   L = ln(2/δ)/N
-//! J (Hoeffding):     ε_J  = c Σ_{t<H} γ^t · √(ln(2/δ)/(2N)),   c = 2R (two-sided) or R
+//! R' = R (two-sided, b = 0)  or  R/2 (non-positive, b = −R/2);   a_t = γ^t R';   L = ln(2/δ)/N
+//! v-component (ψ2):  K_v = √(8/3) (M_φ/σ) Σ_{t<H} a_t √(t+1)     ≥ ‖g‖_ψ2
+//!                    ε_v = 2 K_v √(κ L)  if L ≤ κ,   K_v (κ + L)  otherwise,   κ = 2 ln 2
+//! w-component (ψ1):  k_n = ‖χ²_n − n‖_ψ1 (computed, rounded up)
+//!                    K_w = Σ_{t<H} a_t k_{t+1}                    ≥ ‖g‖_ψ1
+//!                    ε_w = K_w √(8 L)  if L ≤ 1/2,   K_w (1 + 2L)  otherwise
+//! J (Hoeffding):     ε_J = c Σ_{t<H} γ^t · √(L/2),   c = 2R (two-sided) or R
 //! ```
+//! `g` is one per-trajectory sample of the component; the norms bound `g` itself, not its
+//! centred version: the moment generating function of `g − E g` is bounded through an
+//! independent copy of `g` ([`psi2_width`], [`psi1_width`]).
 //! Every width is multiplied by `1 + 4(H + 16)u` (`u` the unit roundoff) to cover the
 //! rounding of its evaluation.
 
@@ -85,8 +86,6 @@ pub struct ProvenWidths {
     v_sum: f64,
     /// `K_w = Σ_t a_t k_{t+1}`.
     w_norm: f64,
-    /// `K'_w`.
-    w_centred: f64,
     /// `c Σ_t γ^t`, the length of an interval holding every discounted return.
     j_range: f64,
     /// `1 + 4(H + 16)u`.
@@ -152,19 +151,17 @@ impl ProvenWidths {
             discount *= gamma;
         }
         let psi1 = Chi2Psi1::new(discounts.len().min(DIRECT_DOF))?;
-        let (mut v_sum, mut w_norm, mut w_std) = (0.0, 0.0, 0.0);
+        let (mut v_sum, mut w_norm) = (0.0, 0.0);
         for (t, discount) in discounts.iter().enumerate() {
             let dof = t + 1;
             let a = discount * deviation;
             let root = (dof as f64).sqrt();
             v_sum += a * root;
             w_norm += a * psi1.norm(dof);
-            w_std += a * std::f64::consts::SQRT_2 * root;
         }
         let discounts: f64 = discounts.iter().sum();
-        let w_centred = w_norm + w_norm.min(w_std / LN_2);
         let j_range = j_scale * discounts;
-        if ![v_sum, w_centred, j_range].iter().all(|x| x.is_finite()) {
+        if ![v_sum, w_norm, j_range].iter().all(|x| x.is_finite()) {
             return Err(EstimatorError::NonFinite {
                 what: "proven width constants (overflow)",
             });
@@ -179,7 +176,6 @@ impl ProvenWidths {
             deviation,
             v_sum,
             w_norm,
-            w_centred,
             j_range,
             rounding: 1.0 + 4.0 * (horizon as f64 + 16.0) * f64::EPSILON,
         })
@@ -255,36 +251,20 @@ impl ProvenWidths {
         finite((8.0f64 / 3.0).sqrt() * scale, "v-component psi2 norm")
     }
 
-    /// `K'_v`, a bound on the ψ2 norm of the centred sample `g − E g` of a v-component.
-    ///
-    /// # Formula
-    /// ```text
-    /// K'_v = (√(8/3) + 1/√(ln 2)) (M_φ/σ) Σ_{t<H} γ^t R' √(t+1)
-    /// ```
-    ///
-    /// # Errors
-    /// As [`ProvenWidths::v_psi2_norm`].
-    pub fn v_centred_norm(&self, sigma: f64) -> Result<f64, EstimatorError> {
-        let scale = self.v_scale(sigma)?;
-        finite(
-            ((8.0f64 / 3.0).sqrt() + 1.0 / LN_2.sqrt()) * scale,
-            "v-component centred psi2 norm",
-        )
-    }
-
     /// The proven half-width `ε_v` of a v-component estimate (mean of `n ≥ 1` samples) of an
     /// action with standard deviation `σ > 0`, two-sided at level `δ ∈ (0, 1)`:
     /// `P(|∇̂_v J − ∇_v J| ≥ ε_v) ≤ δ` (return units per parameter unit).
     ///
     /// # Formula
     /// ```text
-    /// ε_v = 2 K'_v √(ln(2/δ)/n)
+    /// L = ln(2/δ)/n,   κ = 2 ln 2
+    /// ε_v = 2 K_v √(κ L)  if L ≤ κ,   K_v (κ + L)  otherwise
     /// ```
     ///
     /// # Errors
     /// As [`ProvenWidths::v_psi2_norm`], and as [`psi2_width`].
     pub fn v_width(&self, sigma: f64, n: usize, delta: f64) -> Result<f64, EstimatorError> {
-        let width = psi2_width(self.v_centred_norm(sigma)?, n, delta)?;
+        let width = psi2_width(self.v_psi2_norm(sigma)?, n, delta)?;
         finite(width * self.rounding, "v-component proven width")
     }
 
@@ -299,29 +279,20 @@ impl ProvenWidths {
         self.w_norm
     }
 
-    /// `K'_w`, a bound on the ψ1 norm of the centred sample `g − E g` of a w-component.
-    ///
-    /// # Formula
-    /// ```text
-    /// K'_w = K_w + min(K_w, Σ_{t<H} γ^t R' √(2(t+1)) / ln 2)
-    /// ```
-    pub fn w_centred_norm(&self) -> f64 {
-        self.w_centred
-    }
-
     /// The proven half-width `ε_w` of a w-component estimate (mean of `n ≥ 1` samples),
     /// two-sided at level `δ ∈ (0, 1)`: `P(|∇̂_w J − ∇_w J| ≥ ε_w) ≤ δ` (return units; it
     /// does not depend on `σ`).
     ///
     /// # Formula
     /// ```text
-    /// ε_w = 2 K'_w √L  if L ≤ 1,   K'_w (1 + L)  otherwise,     L = ln(2/δ)/n
+    /// L = ln(2/δ)/n
+    /// ε_w = K_w √(8 L)  if L ≤ 1/2,   K_w (1 + 2L)  otherwise
     /// ```
     ///
     /// # Errors
     /// As [`psi1_width`].
     pub fn w_width(&self, n: usize, delta: f64) -> Result<f64, EstimatorError> {
-        let width = psi1_width(self.w_centred, n, delta)?;
+        let width = psi1_width(self.w_norm, n, delta)?;
         finite(width * self.rounding, "w-component proven width")
     }
 
@@ -360,14 +331,17 @@ impl ProvenWidths {
     }
 }
 
-/// The two-sided half-width for the mean of `n ≥ 1` i.i.d. samples whose centred version has
-/// Orlicz ψ2 norm at most `norm` (`E e^{(Y/norm)²} ≤ 2`), at level `δ ∈ (0, 1)`. Units of
-/// `norm`.
+/// The two-sided half-width for the mean of `n ≥ 1` i.i.d. samples `g_i` with Orlicz ψ2 norm
+/// at most `norm` (`E e^{(g/K)²} ≤ 2`; `g` need not be centred), at level `δ ∈ (0, 1)`:
+/// `P(|ḡ − E g| ≥ ε) ≤ δ`. Units of `norm`.
 ///
 /// # Formula
 /// ```text
-/// E e^{λY} ≤ e^{λ² K²} for all λ   ⇒   P(|Ȳ| ≥ ε) ≤ 2 e^{−n ε² / (4 K²)} = δ
-/// ε = 2 K √(ln(2/δ)/n)
+/// E e^{λ(g − Eg)} ≤ E e^{λ(g − g′)} ≤ E e^{λ²(g − g′)²/2} ≤ (E e^{λ²g²})² ≤ e^{κ λ² K²}
+///     for |λ| ≤ 1/K,   κ = 2 ln 2   (g′ an independent copy; docs/THEOREMS.md)
+/// L = ln(2/δ)/n
+/// ε = 2 K √(κ L)      if L ≤ κ    (Chernoff at λ = ε/(2κK²) ≤ 1/K)
+/// ε = K (κ + L)       if L > κ    (λ = 1/K)
 /// ```
 ///
 /// # Errors
@@ -378,25 +352,34 @@ impl ProvenWidths {
 /// # Examples
 /// ```
 /// use sepg_estimators::proven::psi2_width;
-/// // K = 1, n = 4, δ = 2/e: ε = 2 √(1/4) = 1.
-/// assert!((psi2_width(1.0, 4, 2.0 / std::f64::consts::E)? - 1.0).abs() < 1e-15);
+/// // K = 1, n = 4, δ = 2/e: L = 1/4 ≤ κ, ε = 2 √(2 ln 2 / 4) = √(2 ln 2).
+/// let eps = psi2_width(1.0, 4, 2.0 / std::f64::consts::E)?;
+/// assert!((eps - (2.0 * std::f64::consts::LN_2).sqrt()).abs() < 1e-15);
 /// # Ok::<(), sepg_estimators::EstimatorError>(())
 /// ```
 pub fn psi2_width(norm: f64, n: usize, delta: f64) -> Result<f64, EstimatorError> {
     check_norm(norm)?;
     let l = log_two_over(n, delta)? / n as f64;
-    finite(2.0 * norm * l.sqrt(), "psi2 width")
+    let kappa = 2.0 * LN_2;
+    let width = if l <= kappa {
+        2.0 * norm * (kappa * l).sqrt()
+    } else {
+        norm * (kappa + l)
+    };
+    finite(width, "psi2 width")
 }
 
-/// The two-sided half-width for the mean of `n ≥ 1` i.i.d. samples whose centred version has
-/// Orlicz ψ1 norm at most `norm` (`E e^{|Y|/norm} ≤ 2`), at level `δ ∈ (0, 1)`. Units of
-/// `norm`.
+/// The two-sided half-width for the mean of `n ≥ 1` i.i.d. samples `g_i` with Orlicz ψ1 norm
+/// at most `norm` (`E e^{|g|/K} ≤ 2`; `g` need not be centred), at level `δ ∈ (0, 1)`:
+/// `P(|ḡ − E g| ≥ ε) ≤ δ`. Units of `norm`.
 ///
 /// # Formula
 /// ```text
-/// E e^{λY} ≤ 1 + λ²K² ≤ e^{λ²K²} for |λ| ≤ 1/K,    L = ln(2/δ)/n
-/// ε = 2 K √L          if L ≤ 1   (λ = ε/(2K²) ≤ 1/K)
-/// ε = K (1 + L)       if L > 1   (λ = 1/K)
+/// E e^{λ(g − Eg)} ≤ E cosh(λ(g − g′)) ≤ 1 + 4λ²K² (E cosh(g/K) − 1) ≤ 1 + 2λ²K² ≤ e^{2λ²K²}
+///     for |λ| ≤ 1/(2K)   (g′ an independent copy; docs/THEOREMS.md)
+/// L = ln(2/δ)/n
+/// ε = K √(8 L)        if L ≤ 1/2   (Chernoff at λ = ε/(4K²) ≤ 1/(2K))
+/// ε = K (1 + 2L)      if L > 1/2   (λ = 1/(2K))
 /// ```
 ///
 /// # Errors
@@ -405,17 +388,17 @@ pub fn psi2_width(norm: f64, n: usize, delta: f64) -> Result<f64, EstimatorError
 /// # Examples
 /// ```
 /// use sepg_estimators::proven::psi1_width;
-/// // K = 1, n = 1, δ = 2/e³: L = 3 > 1, ε = 1 + 3.
-/// assert!((psi1_width(1.0, 1, 2.0 * (-3.0f64).exp())? - 4.0).abs() < 1e-14);
+/// // K = 1, n = 1, δ = 2/e³: L = 3 > 1/2, ε = 1 + 6.
+/// assert!((psi1_width(1.0, 1, 2.0 * (-3.0f64).exp())? - 7.0).abs() < 1e-14);
 /// # Ok::<(), sepg_estimators::EstimatorError>(())
 /// ```
 pub fn psi1_width(norm: f64, n: usize, delta: f64) -> Result<f64, EstimatorError> {
     check_norm(norm)?;
     let l = log_two_over(n, delta)? / n as f64;
-    let width = if l <= 1.0 {
-        2.0 * norm * l.sqrt()
+    let width = if l <= 0.5 {
+        norm * (8.0 * l).sqrt()
     } else {
-        norm * (1.0 + l)
+        norm * (1.0 + 2.0 * l)
     };
     finite(width, "psi1 width")
 }

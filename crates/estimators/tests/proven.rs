@@ -148,10 +148,10 @@ fn psi1_constant_is_valid_and_tight() {
     assert!((got / expected - 1.0).abs() < 1e-6);
 }
 
-/// `min_{0 < λ ≤ λ_max} exp(n(λ² K² − λ ε))` by golden-section search on the exponent
-/// (convex in λ) and a fine grid for the bracket.
-fn chernoff_bound(norm: f64, n: usize, eps: f64, lambda_max: f64) -> f64 {
-    let exponent = |l: f64| n as f64 * (l * l * norm * norm - l * eps);
+/// `min_{0 < λ ≤ λ_max} exp(n(κ λ² K² − λ ε))` by a grid and golden-section search on the
+/// exponent (convex in λ).
+fn chernoff_bound(kappa: f64, norm: f64, n: usize, eps: f64, lambda_max: f64) -> f64 {
+    let exponent = |l: f64| n as f64 * (kappa * l * l * norm * norm - l * eps);
     let grid = 10_000;
     let best = (1..=grid)
         .map(|i| lambda_max * i as f64 / grid as f64)
@@ -173,19 +173,22 @@ fn chernoff_bound(norm: f64, n: usize, eps: f64, lambda_max: f64) -> f64 {
 
 #[test]
 fn widths_invert_the_chernoff_bound() {
-    // For the sub-Gaussian lemma E e^{λY} ≤ e^{λ²K²} (all λ) and the sub-exponential one
-    // (|λ| ≤ 1/K), the width is the ε at which the one-sided Chernoff bound equals δ/2.
+    // Sub-Gaussian lemma: E e^{λ(g−Eg)} ≤ e^{2 ln 2 λ²K²} for |λ| ≤ 1/K; sub-exponential
+    // lemma: E e^{λ(g−Eg)} ≤ e^{2λ²K²} for |λ| ≤ 1/(2K). The width is the ε at which the
+    // one-sided Chernoff bound of the mean of n samples, minimised over the allowed λ,
+    // equals δ/2. The cases cover both regimes of each width.
     for (norm, n, delta) in [
         (1.0, 50, 1e-5),
         (3.5, 10, 0.05),
         (0.2, 1000, 0.2),
         (2.0, 1, 0.3),
         (1.0, 3, 1e-5),
+        (1.0, 1, 1e-9),
     ] {
         let e2 = psi2_width(norm, n, delta).unwrap();
-        let b2 = chernoff_bound(norm, n, e2, 100.0 / norm);
+        let b2 = chernoff_bound(2.0 * std::f64::consts::LN_2, norm, n, e2, 1.0 / norm);
         let e1 = psi1_width(norm, n, delta).unwrap();
-        let b1 = chernoff_bound(norm, n, e1, 1.0 / norm);
+        let b1 = chernoff_bound(2.0, norm, n, e1, 0.5 / norm);
         eprintln!(
             "K {norm} n {n} δ {delta}: ψ2 ε {e2:.6} bound {b2:.6e}; ψ1 ε {e1:.6} bound {b1:.6e}"
         );
@@ -199,39 +202,58 @@ fn widths_invert_the_chernoff_bound() {
     }
 }
 
+/// `max over the grid of ln E e^{λ(g − Eg)} / (κ λ² K²)` for `0 < |λ| ≤ λ_max`.
+fn worst_ratio(log_mgf: impl Fn(f64) -> f64, kappa: f64, norm: f64, lambda_max: f64) -> f64 {
+    (-2000..=2000)
+        .filter(|i| *i != 0)
+        .map(|i| {
+            let l = lambda_max * i as f64 / 2000.0;
+            log_mgf(l) / (kappa * l * l * norm * norm)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
 #[test]
-fn sub_exponential_lemma_holds_for_the_chi_squared_sums() {
-    // E e^{λZ} ≤ e^{λ² k_n²} for |λ| ≤ 1/k_n, Z = χ²_n − n (mean zero, ψ1 norm k_n), with
-    // the exact moment generating function e^{−λn} (1 − 2λ)^{−n/2}.
+fn sub_exponential_lemma_holds_on_examples() {
+    // E e^{λ(g − Eg)} ≤ e^{2λ²K²} for |λ| ≤ 1/(2K), K = ‖g‖_ψ1, on laws with exact moment
+    // generating functions: Z = χ²_n − n (centred, K = k_n), Q = χ²_n (not centred,
+    // E e^{Q/K} = (1 − 2/K)^{−n/2} = 2 gives K = 2/(1 − 2^{−2/n})), and Bernoulli(p)
+    // (K = 1/ln(1 + 1/p)).
+    let chi2 = |n: f64| move |l: f64| -l * n - 0.5 * n * (-2.0 * l).ln_1p();
     for n in [1usize, 2, 5, 20, 100] {
-        let k = chi2_psi1_norm(n).unwrap();
         let nf = n as f64;
-        let mut worst = f64::NEG_INFINITY;
-        for i in (-1000..=1000).filter(|i| *i != 0) {
-            let l = i as f64 / (1000.0 * k);
-            let log_mgf = -l * nf - 0.5 * nf * (-2.0 * l).ln_1p();
-            worst = worst.max(log_mgf / (l * l * k * k));
-        }
-        eprintln!("n = {n}: max over λ of ln E e^(λZ) / (λ²K²) = {worst:.4}");
-        assert!(worst <= 1.0, "n = {n}");
+        let k = chi2_psi1_norm(n).unwrap();
+        let centred = worst_ratio(chi2(nf), 2.0, k, 0.5 / k);
+        let kq = 2.0 / (1.0 - 2f64.powf(-2.0 / nf));
+        let raw = worst_ratio(chi2(nf), 2.0, kq, 0.5 / kq);
+        eprintln!("χ²_{n}: worst ratio {centred:.4} (centred), {raw:.4} (not centred)");
+        assert!(centred <= 1.0 && raw <= 1.0, "n = {n}");
+    }
+    for p in [0.5f64, 0.1, 0.01, 1e-3, 1e-5] {
+        let k = 1.0 / (1.0 / p).ln_1p();
+        let bern = |l: f64| (p * (l * (1.0 - p)).exp() + (1.0 - p) * (-l * p).exp()).ln();
+        let r = worst_ratio(bern, 2.0, k, 0.5 / k);
+        eprintln!("Bernoulli({p}): K = {k:.5}, worst ratio {r:.4}");
+        assert!(r <= 1.0, "p = {p}");
     }
 }
 
 #[test]
-fn sub_gaussian_lemma_holds_for_skewed_two_point_laws() {
-    // Y = 1 − p w.p. p, −p w.p. 1 − p (mean zero, skewed for small p); its ψ2 norm K by
-    // bisection on p e^{(1−p)²/K²} + (1 − p) e^{p²/K²} = 2; then E e^{λY} ≤ e^{λ²K²}.
-    for p in [0.5, 0.1, 0.01, 1e-3, 1e-5] {
-        let moment = |k: f64| p * ((1.0 - p) / k).powi(2).exp() + (1.0 - p) * (p / k).powi(2).exp();
-        let k = solve_norm(moment, 1e-3, 10.0);
-        let mut worst = f64::NEG_INFINITY;
-        for i in (-4000..=4000).filter(|i| *i != 0) {
-            let l = i as f64 / (100.0 * k);
-            let mgf = p * (l * (1.0 - p)).exp() + (1.0 - p) * (-l * p).exp();
-            worst = worst.max(mgf.ln() / (l * l * k * k));
-        }
-        eprintln!("p = {p}: K = {k:.5}, max over λ of ln E e^(λY) / (λ²K²) = {worst:.4}");
-        assert!(worst <= 1.0, "p = {p}");
+fn sub_gaussian_lemma_holds_on_examples() {
+    // E e^{λ(g − Eg)} ≤ e^{2 ln 2 λ²K²} for |λ| ≤ 1/K, K = ‖g‖_ψ2, on Bernoulli(p)
+    // (K = 1/√ln(1 + 1/p), mean p: skewed and not centred) and on two-point laws ±1 with
+    // P(+1) = p (K = 1/√ln 2 whatever p, mean 2p − 1).
+    let kappa = 2.0 * std::f64::consts::LN_2;
+    for p in [0.5f64, 0.1, 0.01, 1e-3, 1e-5] {
+        let k = 1.0 / (1.0 / p).ln_1p().sqrt();
+        let bern = |l: f64| (p * (l * (1.0 - p)).exp() + (1.0 - p) * (-l * p).exp()).ln();
+        let r = worst_ratio(bern, kappa, k, 1.0 / k);
+        let ks = 1.0 / std::f64::consts::LN_2.sqrt();
+        let m = 2.0 * p - 1.0;
+        let sign = |l: f64| (p * (l * (1.0 - m)).exp() + (1.0 - p) * (-l * (1.0 + m)).exp()).ln();
+        let rs = worst_ratio(sign, kappa, ks, 1.0 / ks);
+        eprintln!("p = {p}: Bernoulli K = {k:.5} worst ratio {r:.4}; ±1 worst ratio {rs:.4}");
+        assert!(r <= 1.0 && rs <= 1.0, "p = {p}");
     }
 }
 
