@@ -4,7 +4,8 @@
 //! under-cover at small `N`; these do not.
 //!
 //! # Conditions
-//! - rewards `|r_t| ≤ R` (or `r_t ∈ [−R, 0]` when declared non-positive);
+//! - rewards `|r_t| ≤ R` surely (or `r_t ∈ [−R, 0]` when declared non-positive); Mountain
+//!   Car's penalty on the raw action is not bounded, so the widths do not apply to it as is;
 //! - features `|φ_i(s)| ≤ M_φ` for every component and state;
 //! - the Gaussian policy `a = μ(s) + σ ξ`, `ξ ~ N(0, 1)` i.i.d. across steps and action
 //!   dimensions, with the scores of the raw sampled action: `∇_{v_{j,i}} log π = ξ_j φ_i(s)/σ_j`,
@@ -47,6 +48,9 @@ pub const DIRECT_DOF: usize = 4096;
 /// The value of `E e^{|Z|/K}` that the computed `K` must not exceed: 2 minus a margin that
 /// covers the rounding of the incomplete gamma functions (relative error ~1e-14).
 const PSI1_TARGET: f64 = 2.0 - 1e-9;
+
+/// The largest horizon accepted by [`ProvenWidths::new`] (its cost is linear in `H`).
+pub const MAX_HORIZON: usize = 100_000_000;
 
 /// Relative width of the bracket at which the bisection of [`chi2_psi1_norm`] stops.
 const BISECTION_TOL: f64 = 1e-11;
@@ -97,11 +101,12 @@ impl ProvenWidths {
     /// (`O(min(H, 4096))` incomplete-gamma bisections for the ψ1 norms, once).
     ///
     /// `r_max` is `R` (reward units), `rewards_non_positive` declares `r_t ∈ [−R, 0]`,
-    /// `m_phi` is `M_φ` (feature units), `gamma ∈ [0, 1)`, `horizon = H ≥ 1` steps.
+    /// `m_phi` is `M_φ` (feature units), `gamma ∈ [0, 1)`, `horizon = H` steps with
+    /// `1 ≤ H ≤` [`MAX_HORIZON`].
     ///
     /// # Errors
     /// [`EstimatorError::InvalidTaskConstant`] for `R` or `M_φ` not finite and positive,
-    /// `γ ∉ [0, 1)` or `H = 0`; [`EstimatorError::NonFinite`] if a sum overflows.
+    /// `γ ∉ [0, 1)` or `H` outside `[1, MAX_HORIZON]`; [`EstimatorError::NonFinite`] if a sum overflows.
     ///
     /// # Examples
     /// ```
@@ -132,10 +137,10 @@ impl ProvenWidths {
                 value: gamma,
             });
         }
-        if horizon == 0 {
+        if horizon == 0 || horizon > MAX_HORIZON {
             return Err(EstimatorError::InvalidTaskConstant {
                 what: "horizon",
-                value: 0.0,
+                value: horizon as f64,
             });
         }
         let (baseline, deviation, j_scale) = if rewards_non_positive {
@@ -143,23 +148,23 @@ impl ProvenWidths {
         } else {
             (0.0, r_max, 2.0 * r_max)
         };
-        // The discounts γ^t, up to the first that is zero (γ = 0 or underflow).
-        let mut discounts = Vec::new();
+        // The steps whose discount γ^t is not zero (γ = 0 or underflow end the sums).
+        let mut steps = 0;
         let mut discount = 1.0f64;
-        while discounts.len() < horizon && discount > 0.0 {
-            discounts.push(discount);
+        while steps < horizon && discount > 0.0 {
+            steps += 1;
             discount *= gamma;
         }
-        let psi1 = Chi2Psi1::new(discounts.len().min(DIRECT_DOF))?;
-        let (mut v_sum, mut w_norm) = (0.0, 0.0);
-        for (t, discount) in discounts.iter().enumerate() {
-            let dof = t + 1;
+        let psi1 = Chi2Psi1::new(steps.min(DIRECT_DOF))?;
+        let (mut v_sum, mut w_norm, mut discounts) = (0.0, 0.0, 0.0);
+        let mut discount = 1.0f64;
+        for dof in 1..=steps {
             let a = discount * deviation;
-            let root = (dof as f64).sqrt();
-            v_sum += a * root;
+            v_sum += a * (dof as f64).sqrt();
             w_norm += a * psi1.norm(dof);
+            discounts += discount;
+            discount *= gamma;
         }
-        let discounts: f64 = discounts.iter().sum();
         let j_range = j_scale * discounts;
         if ![v_sum, w_norm, j_range].iter().all(|x| x.is_finite()) {
             return Err(EstimatorError::NonFinite {

@@ -288,6 +288,7 @@ fn invalid_inputs_are_typed_errors() {
         ProvenWidths::new(1.0, false, 1.0, -0.1, 20),
         ProvenWidths::new(1.0, false, 1.0, f64::NAN, 20),
         ProvenWidths::new(1.0, false, 1.0, 0.9, 0),
+        ProvenWidths::new(1.0, false, 1.0, 0.9, usize::MAX),
     ];
     for b in bad {
         assert!(matches!(b, Err(E::InvalidTaskConstant { .. })), "{b:?}");
