@@ -68,6 +68,15 @@ pub enum EstimatorError {
         /// The offending value.
         value: f64,
     },
+    /// A constant of the task (`R`, `M_φ`, `γ`, the horizon `H`) is outside its domain: `R`
+    /// and `M_φ` finite and positive, `γ ∈ [0, 1)`, `H ≥ 1`.
+    #[error("task constant {what} = {value} is outside its domain")]
+    InvalidTaskConstant {
+        /// Which constant.
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+    },
     /// The confidence width needs the per-trajectory samples (e.g. their third moment), not
     /// only the variance: use the methods of [`crate::Estimate`].
     #[error("the {method} width needs the samples: use Estimate::widths_into")]

@@ -31,7 +31,7 @@ pub enum Kind {
 }
 
 /// The baseline subtracted from the rewards (Sec 2.3.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Baseline {
     /// No baseline, `b = 0`.
     None,
@@ -42,6 +42,16 @@ pub enum Baseline {
     /// `⟨S_{t,k}² γ^t r_t⟩/⟨S_{t,k}²⟩` per step for G(PO)MDP/PGT, and `b̃*_t` of Appendix B.2
     /// for `ĥ`. A zero denominator gives the baseline 0.
     Optimal,
+    /// A constant `b` (reward units) fixed before sampling, subtracted from the reward of
+    /// every step `t < H`, including the padding after an early termination (reward 0,
+    /// cumulative scores frozen): `γ^t r_t − γ^t b` per step (G(PO)MDP, PGT, `ĥ`) and
+    /// `R − b Σ_{t<H} γ^t` for REINFORCE. It is not fitted (`fit` is ignored), so the
+    /// per-trajectory samples are i.i.d. and the estimator is exactly unbiased: the
+    /// cumulative score stopped at termination is a martingale, `E[Σ_t γ^t b S_t] = 0`.
+    /// Subtracting `b` on the live steps only would not be: `E[Σ_{t<L} γ^t S_t]` is the
+    /// gradient of the expected discounted length. This is the centre of the proven widths
+    /// of [`crate::proven`] (docs/THEOREMS.md, "Proven confidence widths"). `b` must be finite.
+    Constant(f64),
 }
 
 /// How a baseline is fitted from the batch.
@@ -68,7 +78,7 @@ pub enum BaselineFit {
 /// let s = GradientSpec::default();
 /// assert_eq!((s.kind, s.baseline, s.fit), (Kind::Gpomdp, Baseline::Optimal, BaselineFit::LeaveOneOut));
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GradientSpec {
     /// The estimator.
     pub kind: Kind,
@@ -138,6 +148,8 @@ pub struct Estimator {
     /// Products `u = G H F` and control variates `z` of `ĥ`, per (trajectory, step, pair).
     h_u: Vec<f64>,
     h_z: Vec<f64>,
+    /// Discounted rewards minus a constant baseline, `γ^t (r_t − b)`.
+    shifted: Vec<f64>,
     /// Scratch estimates and vectors of the composite estimators.
     pub(crate) tmp_g: Estimate,
     pub(crate) vec_a: Vec<f64>,
@@ -216,6 +228,16 @@ pub(crate) fn validate(batch: &Batch, min_n: usize) -> Result<(), EstimatorError
     Ok(())
 }
 
+/// Checks that a [`Baseline::Constant`] is finite.
+pub(crate) fn check_baseline(baseline: Baseline) -> Result<(), EstimatorError> {
+    match baseline {
+        Baseline::Constant(b) if !b.is_finite() => Err(EstimatorError::NonFinite {
+            what: "constant baseline",
+        }),
+        _ => Ok(()),
+    }
+}
+
 fn dim_of(batch: &Batch, param: Param) -> usize {
     match param {
         Param::V => batch.dim_v,
@@ -273,12 +295,13 @@ impl Estimator {
     /// G(PO)MDP:   x_i = Σ_t S_{i,t} (F_{i,t} − b_t)   b_t = ⟨S_t² F_t⟩/⟨S_t²⟩ or ⟨F_t⟩
     /// PGT:        x_i = Σ_k (S_{i,k} − S_{i,k−1}) Σ_{l≥k} (F_{i,l} − b_l)
     /// estimate = (1/N) Σ_i x_i      (component-wise; ⟨·⟩ over all, or the other N − 1, rows)
+    /// Constant(c): b = c Σ_{t<H} γ^t (REINFORCE),  b_t = γ^t c (G(PO)MDP, PGT)
     /// ```
     /// Units: return units per parameter unit.
     ///
     /// # Errors
     /// [`EstimatorError`] for an empty batch, `N < 2`, inconsistent buffer sizes, invalid `σ`,
-    /// non-finite data or overflow.
+    /// non-finite data or constant baseline, or overflow.
     ///
     /// # Examples
     /// ```
@@ -303,6 +326,7 @@ impl Estimator {
         out: &mut Estimate,
     ) -> Result<(), EstimatorError> {
         validate(batch, 2)?;
+        check_baseline(spec.baseline)?;
         let samples = out.reset(batch.n, dim_of(batch, param));
         self.kernel(
             batch,
@@ -325,6 +349,7 @@ impl Estimator {
     /// Optimal (B.2): x_{jk} = Σ_t [G H F − b̃_t (G + H)],   b̃_t = ⟨G H F (G + H)⟩ / ⟨(G + H)²⟩
     /// Mean:          x_{jk} = Σ_t G H (F − ⟨F_t⟩)           (valid since E[G_t H_t] = 0)
     /// None:          x_{jk} = Σ_t G H F
+    /// Constant(c):   x_{jk} = Σ_t G H (F − γ^t c)           (also valid since E[G_t H_t] = 0)
     /// ```
     /// The σ-score of action `j` is the w-score divided by `σ_j`. The pairs with `j` equal to
     /// the action of `v_k` (`k / p`, `p = dim_v / dim_w`) form the `h` of the thesis; the
@@ -357,6 +382,7 @@ impl Estimator {
         out: &mut Estimate,
     ) -> Result<(), EstimatorError> {
         validate(batch, 2)?;
+        check_baseline(baseline)?;
         let samples = out.reset(batch.n, batch.dim_w * batch.dim_v);
         self.kernel(batch, 0..batch.n, Target::H, baseline, fit, samples);
         out.finish()
@@ -397,6 +423,7 @@ impl Estimator {
         out: &mut Estimate,
     ) -> Result<(), EstimatorError> {
         validate(batch, 2)?;
+        check_baseline(spec.baseline)?;
         let mut g = std::mem::take(&mut self.tmp_g);
         let gs = g.reset(batch.n, batch.dim_v);
         let target = Target::gradient(spec.kind, Param::V);
@@ -409,7 +436,9 @@ impl Estimator {
     }
 
     /// Runs one estimator on the trajectories `rows`, writing `rows.len() × comps` samples
-    /// (see [`crate::kernel`]; every baseline is fitted on `rows` only).
+    /// (see [`crate::kernel`]; every baseline is fitted on `rows` only). A constant baseline
+    /// is applied by running the estimator without baseline on the shifted rewards
+    /// `γ^t (r_t − b)`.
     pub(crate) fn kernel(
         &mut self,
         batch: &Batch,
@@ -421,7 +450,15 @@ impl Estimator {
     ) {
         let h = batch.horizon;
         let nr = rows.len();
+        let mut shifted = std::mem::take(&mut self.shifted);
         let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
+        let (rewards, baseline) = match baseline {
+            Baseline::Constant(b) => {
+                shift_rewards(&mut shifted, rewards, h, batch.gamma, b);
+                (&shifted[..], Baseline::None)
+            }
+            fitted => (rewards, fitted),
+        };
         let scores = |p: Param| match p {
             Param::V => (
                 &batch.cum_score_v[rows.start * h * batch.dim_v..],
@@ -472,7 +509,7 @@ impl Estimator {
             Target::Reinforce(p) => {
                 let (s, comps) = scores(p);
                 self.returns.resize(nr, 0.0);
-                returns_into(batch, rows, &mut self.returns);
+                row_returns(rewards, h, &mut self.returns);
                 let s = Rows::new(&s[(h - 1) * comps..], h * comps);
                 let f = broadcast(&mut self.bcast, &self.returns, 1, comps);
                 run_score(
@@ -488,7 +525,7 @@ impl Estimator {
                 );
             }
             Target::H => {
-                self.fill_h(batch, rows, baseline);
+                self.fill_h(batch, rows, rewards, baseline);
                 let comps = batch.dim_w * batch.dim_v;
                 let w = h * comps;
                 let (u, z) = (Rows::new(&self.h_u, w), Rows::new(&self.h_z, w));
@@ -503,17 +540,22 @@ impl Estimator {
                 }
             }
         }
+        self.shifted = shifted;
     }
 
     /// Fills `h_u` with `u = G_k H_j F` and `h_z` with the control variate of `baseline`
-    /// (`G_k + H_j` optimal, `G_k H_j` mean, 0 without baseline) for the trajectories `rows`,
-    /// entry `(r · steps + t) · dim_w · dim_v + j · dim_v + k`, where `H_j` is the cumulative
-    /// w-score divided by `σ_j` (the σ-score).
-    fn fill_h(&mut self, batch: &Batch, rows: Range<usize>, baseline: Baseline) {
+    /// (`G_k + H_j` optimal, `G_k H_j` mean, 0 without baseline) for the trajectories `rows`
+    /// with discounted rewards `rewards` (`rows.len() × steps`), entry
+    /// `(r · steps + t) · dim_w · dim_v + j · dim_v + k`, where `H_j` is the cumulative
+    /// w-score divided by `σ_j` (the σ-score). A constant baseline has no control variate:
+    /// it is already subtracted from `rewards`.
+    fn fill_h(&mut self, batch: &Batch, rows: Range<usize>, rewards: &[f64], baseline: Baseline) {
         match baseline {
-            Baseline::None => self.fill_h_with(batch, rows, |_, _| 0.0),
-            Baseline::Mean => self.fill_h_with(batch, rows, |g, h| g * h),
-            Baseline::Optimal => self.fill_h_with(batch, rows, |g, h| g + h),
+            Baseline::None | Baseline::Constant(_) => {
+                self.fill_h_with(batch, rows, rewards, |_, _| 0.0)
+            }
+            Baseline::Mean => self.fill_h_with(batch, rows, rewards, |g, h| g * h),
+            Baseline::Optimal => self.fill_h_with(batch, rows, rewards, |g, h| g + h),
         }
     }
 
@@ -523,6 +565,7 @@ impl Estimator {
         &mut self,
         batch: &Batch,
         rows: Range<usize>,
+        rewards: &[f64],
         control: impl Fn(f64, f64) -> f64,
     ) {
         let (h, m, l) = (batch.horizon, batch.dim_v, batch.dim_w);
@@ -533,7 +576,7 @@ impl Estimator {
         self.h_z.resize(len, 0.0);
         let g_all = &batch.cum_score_v[rows.start * h * m..rows.end * h * m];
         let w_all = &batch.cum_score_w[rows.start * h * l..rows.end * h * l];
-        let f_all = &batch.disc_rewards[rows.start * h..rows.end * h];
+        let f_all = rewards;
         if width == 1 {
             // One action, one feature: one flat loop over all steps.
             let sigma = batch.sigma[0];
@@ -609,8 +652,28 @@ fn broadcast<'a>(
 /// `−0.0` in the order of `t` (the same bits as [`Batch::discounted_return`]).
 pub(crate) fn returns_into(batch: &Batch, rows: Range<usize>, out: &mut [f64]) {
     let h = batch.horizon;
-    let rewards = Rows::new(&batch.disc_rewards[rows.start * h..rows.end * h], h);
-    row_sums(&mut out[..rows.len()], h, -0.0, [rewards], |[f]| f);
+    row_returns(&batch.disc_rewards[rows.start * h..rows.end * h], h, out);
+}
+
+/// The row sums of `rewards` (rows of `h` steps) into `out`, summed from `−0.0` in the order
+/// of `t`.
+fn row_returns(rewards: &[f64], h: usize, out: &mut [f64]) {
+    let rows = rewards.len() / h;
+    row_sums(&mut out[..rows], h, -0.0, [Rows::new(rewards, h)], |[f]| f);
+}
+
+/// `shifted[r · h + t] = rewards[r · h + t] − γ^t b`: the discounted rewards minus the
+/// discounted constant baseline, at every step `t < h` (padding included).
+fn shift_rewards(shifted: &mut Vec<f64>, rewards: &[f64], h: usize, gamma: f64, b: f64) {
+    shifted.clear();
+    shifted.extend_from_slice(rewards);
+    for row in shifted.chunks_exact_mut(h) {
+        let mut discount = 1.0;
+        for f in row {
+            *f -= discount * b;
+            discount *= gamma;
+        }
+    }
 }
 
 /// Turns `ĥ` samples into `∂_σ ∇_v J` samples: subtracts `(2/σ_j) g_k` where `v_k` belongs to

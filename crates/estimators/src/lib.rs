@@ -1,7 +1,8 @@
 //! Policy-gradient estimators of Safely-Exploring Policy Gradient: REINFORCE, G(PO)MDP and PGT
 //! with baselines (thesis Sec 2.3.1–2.3.2), the estimator of `h(θ)` and the cross-fitted
 //! surrogate gradient `∇_w L` (Appendix B), and the confidence widths and corrected norms of
-//! Sec 4.5, with a Student-t quantile valid for any number of degrees of freedom.
+//! Sec 4.5, with a Student-t quantile valid for any number of degrees of freedom, and the
+//! confidence widths proven at every number of trajectories of [`proven`].
 //!
 //! Everything is computed from a [`sepg_mdp::Batch`] by a reusable [`Estimator`] workspace into
 //! caller-owned [`Estimate`]s, without allocation once the buffers have grown:
@@ -34,6 +35,7 @@ pub mod error;
 pub mod estimate;
 pub mod gradient;
 mod kernel;
+pub mod proven;
 pub mod quantile;
 pub mod surrogate;
 
@@ -41,5 +43,6 @@ pub use confidence::{Confidence, Width, width};
 pub use error::EstimatorError;
 pub use estimate::Estimate;
 pub use gradient::{Baseline, BaselineFit, Estimator, GradientSpec, Kind, Param};
+pub use proven::ProvenWidths;
 pub use quantile::{QuantileError, normal_quantile, student_t_quantile};
 pub use surrogate::SurrogateEstimate;

@@ -18,7 +18,9 @@ use sepg_mdp::Batch;
 
 use crate::error::EstimatorError;
 use crate::estimate::Estimate;
-use crate::gradient::{Estimator, GradientSpec, Param, Target, subtract_score_term, validate};
+use crate::gradient::{
+    Estimator, GradientSpec, Param, Target, check_baseline, subtract_score_term, validate,
+};
 
 /// The outputs of [`Estimator::surrogate_gradient`], reused across calls.
 #[derive(Debug, Clone, Default)]
@@ -118,8 +120,8 @@ impl Estimator {
     /// ```
     /// `g` uses `spec` (G(PO)MDP with the leave-one-out optimal baseline by default), `ĥ` uses
     /// `spec.baseline` with `spec.fit`, all fitted within each half. The estimate is unbiased
-    /// for `BaselineFit::LeaveOneOut` or `Baseline::None`. The samples (delta method, evaluated
-    /// at the full-batch means) have the estimate as mean and, to first order, the
+    /// for `BaselineFit::LeaveOneOut`, `Baseline::None` or `Baseline::Constant`. The samples
+    /// (delta method, evaluated at the full-batch means) have the estimate as mean and, to first order, the
     /// per-trajectory variance of the estimate; their variance feeds the Student-t width.
     ///
     /// # Errors
@@ -151,6 +153,7 @@ impl Estimator {
         out: &mut SurrogateEstimate,
     ) -> Result<(), EstimatorError> {
         validate(batch, 4)?;
+        check_baseline(spec.baseline)?;
         if !(c.is_finite() && c > 0.0) {
             return Err(EstimatorError::InvalidConstant {
                 what: "c",
