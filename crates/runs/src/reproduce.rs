@@ -174,7 +174,7 @@ pub struct OptionFlags {
     /// Clipping threshold of the metagradient's last term [default: 100].
     #[cfg_attr(feature = "clap", arg(long = "metagradient-clip"))]
     pub metagradient_clip: Option<f64>,
-    /// Confidence widths of sampled SEPG [default: student-t].
+    /// Confidence widths of sampled SEPG [default: sub-gaussian].
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     pub confidence: Option<ConfidenceName>,
     /// Multiplier of the Student-t quantile [default: 1].

@@ -233,7 +233,10 @@ pub enum WDirectionName {
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ConfidenceName {
-    /// Student-t widths times `quantile-factor` (Sec 4.5).
+    /// Widths proven at every batch size from R, M_φ, σ, γ and H (sub-Gaussian for ∇_v J,
+    /// sub-exponential for ∇_w J), around G(PO)MDP with a constant baseline.
+    SubGaussian,
+    /// Student-t widths times `quantile-factor` (Sec 4.5): approximate.
     StudentT,
     /// No widths: estimates used as exact (the thesis-era code's δ = 1).
     None,
@@ -471,7 +474,7 @@ pub struct RunSpec {
     )]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub metagradient_clip: Option<f64>,
-    /// Confidence widths of sampled SEPG [default: student-t].
+    /// Confidence widths of sampled SEPG [default: sub-gaussian].
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub confidence: Option<ConfidenceName>,
@@ -710,9 +713,9 @@ impl RunSpec {
             "without w-direction metagradient",
         )?;
         reject(
-            self.quantile_factor.is_some() && self.confidence == Some(ConfidenceName::None),
+            self.quantile_factor.is_some() && self.confidence != Some(ConfidenceName::StudentT),
             "quantile-factor",
-            "with confidence none",
+            "without confidence student-t",
         )?;
         let lb1 =
             algo == AlgoName::SepgLb1 || (naive && self.requirement == Some(RequirementName::Lb1));
@@ -826,9 +829,10 @@ impl RunSpec {
             },
             confidence: match self.confidence {
                 Some(ConfidenceName::None) => Confidence::None,
-                Some(ConfidenceName::StudentT) | None => Confidence::StudentT {
+                Some(ConfidenceName::StudentT) => Confidence::StudentT {
                     factor: self.quantile_factor.unwrap_or(1.0),
                 },
+                Some(ConfidenceName::SubGaussian) | None => defaults.confidence,
             },
             lb1_requirement: match self.lb1_requirement {
                 Some(Lb1Name::Full) => Lb1Requirement::Full,
@@ -982,6 +986,7 @@ impl RunSpec {
         let sampled = sampling.0.is_some();
         let (confidence, quantile_factor) = match o.confidence {
             Confidence::None => (ConfidenceName::None, None),
+            Confidence::SubGaussian => (ConfidenceName::SubGaussian, None),
             Confidence::StudentT { factor } => (ConfidenceName::StudentT, Some(factor)),
         };
         let (w_direction, clip) = match o.w_direction {

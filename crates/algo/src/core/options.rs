@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | [`SepgOptions::w_step`] | [`WStep::Exploring`] | (δ = 1 makes both forms Theorem 4.5) |
 //! | [`SepgOptions::w_direction`] | [`WDirection::CrossFitted`] | [`WDirection::Metagradient`] |
-//! | [`SepgOptions::confidence`] | Student-t, factor 1 | [`Confidence::None`] (δ = 1), or factor 2 |
+//! | [`SepgOptions::confidence`] | [`Confidence::SubGaussian`] (proven) | [`Confidence::None`] (δ = 1), or Student-t with factor 2 |
 //! | [`SepgOptions::lb1_requirement`] | [`Lb1Requirement::Split`] | [`Lb1Requirement::Full`] |
 //! | [`SepgOptions::alternating`] | `false` | `true` |
 //! | [`SepgOptions::reference_batch`] | 1000 | 0 |
@@ -51,6 +51,12 @@ pub enum WDirection {
 /// The confidence widths ε of the sampled mode (Section 4.5).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Confidence {
+    /// Widths proven at every batch size from the task's constants R, M_φ, σ, γ and H
+    /// (`sepg_estimators::proven`, docs/THEOREMS.md "Proven confidence widths"): the
+    /// gradients a guarantee rests on are estimated by G(PO)MDP with a constant baseline, and
+    /// ε_i is the sub-Gaussian (∇_v J) or sub-exponential (∇_w J) width of that estimator. The
+    /// direction ∇̂_w L, which carries no guarantee, keeps Student-t widths.
+    SubGaussian,
     /// ε = 0: the estimates are used as if exact (the thesis-era code's default δ = 1).
     None,
     /// ε_i = factor · t(1 − δ/2, N − 1) · √(Var_i/N); the thesis-era code used factor 2.
@@ -62,7 +68,7 @@ pub enum Confidence {
 
 impl Default for Confidence {
     fn default() -> Self {
-        Confidence::StudentT { factor: 1.0 }
+        Confidence::SubGaussian
     }
 }
 
@@ -73,12 +79,13 @@ impl Confidence {
     /// ```
     /// use sepg_algo::core::options::Confidence;
     /// assert_eq!(Confidence::None.factor(), 0.0);
-    /// assert_eq!(Confidence::default().factor(), 1.0);
+    /// assert_eq!(Confidence::StudentT { factor: 2.0 }.factor(), 2.0);
     /// ```
     pub fn factor(self) -> f64 {
         match self {
             Confidence::None => 0.0,
             Confidence::StudentT { factor } => factor,
+            Confidence::SubGaussian => 1.0,
         }
     }
 }
@@ -214,7 +221,8 @@ impl Default for SepgOptions {
 
 impl SepgOptions {
     /// The defaults with the thesis's bookkeeping: requirements built on estimated J
-    /// ([`Accounting::Estimated`]) and every width at level δ ([`Schedule::Iteration`]).
+    /// ([`Accounting::Estimated`]), Student-t widths (Sec 4.5) and every width at level δ
+    /// ([`Schedule::Iteration`]).
     ///
     /// # Examples
     /// ```
@@ -226,6 +234,7 @@ impl SepgOptions {
         SepgOptions {
             accounting: Accounting::Estimated,
             schedule: Schedule::Iteration,
+            confidence: Confidence::StudentT { factor: 1.0 },
             ..SepgOptions::default()
         }
     }

@@ -157,6 +157,15 @@ pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
                 Confidence::StudentT { .. } => reasons.push(
                     "Student-t widths cover only asymptotically (docs/ERRATA.md §14)".to_string(),
                 ),
+                Confidence::SubGaussian => {
+                    if opts.w_step == crate::core::options::WStep::Theorem49
+                        && matches!(cfg.algorithm, Algorithm::Sepg(_))
+                    {
+                        reasons.push(
+                            "Theorem 4.9's step reads the Student-t width of ∇̂_w L".to_string(),
+                        );
+                    }
+                }
             }
             match opts.schedule {
                 Schedule::Run => (Some(delta), Scope::Run),

@@ -30,13 +30,14 @@ pub mod steps;
 
 use sepg_bounds::constants::TaskConstants;
 use sepg_estimators::GradientSpec;
-use sepg_mdp::env::AnyEnv;
+use sepg_estimators::proven::ProvenWidths;
+use sepg_mdp::env::{AnyEnv, Environment};
 use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 
 use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, check_sampled};
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
-use crate::core::options::{Schedule, SepgOptions, WStep};
+use crate::core::options::{Confidence, Schedule, SepgOptions, WStep};
 use crate::core::record::Record;
 use crate::core::state::State;
 use crate::solver::exact::ExactSource;
@@ -76,18 +77,23 @@ impl PolicySolver {
         let cfg = config.config();
         let constants = *config.constants();
         let source: Box<dyn GradientSource> = match cfg.gradient {
-            GradientMode::Sampled { delta } => Box::new(
-                SampledSource::new(
+            GradientMode::Sampled { delta } => {
+                let level = width_delta(config, delta);
+                let mut source = SampledSource::new(
                     cfg.env.clone(),
                     cfg.horizon,
                     cfg.seed,
-                    width_delta(config, delta),
+                    level,
                     cfg.options.confidence.factor(),
                     cfg.estimator,
                     constants,
                 )
-                .with_score_action(cfg.score_action),
-            ),
+                .with_score_action(cfg.score_action);
+                if cfg.options.confidence == Confidence::SubGaussian {
+                    source = source.with_proven_widths(proven_widths(config)?, level);
+                }
+                Box::new(source)
+            }
             GradientMode::Exact => {
                 let unsupported = |e: sepg_mdp::oracle::OracleError| {
                     ConfigError::ExactUnsupported { env: e.to_string() }
@@ -172,6 +178,24 @@ pub fn width_delta(config: &CheckedConfig, delta: f64) -> f64 {
             delta / (cfg.iterations as f64 * k as f64)
         }
     }
+}
+
+/// The proven widths of a checked configuration (`Confidence::SubGaussian`): R, M_φ and γ of
+/// its constants, its horizon (capped by the environment's time limit) and its rewards' sign
+/// (the LQG rewards −(sᵀQs + aᵀRa) are non-positive; Mountain Car's are not).
+///
+/// # Errors
+/// [`ConfigError::Environment`] when the estimators reject the constants.
+pub fn proven_widths(config: &CheckedConfig) -> Result<ProvenWidths, ConfigError> {
+    let cfg = config.config();
+    let k = config.constants();
+    let non_positive = matches!(cfg.env, AnyEnv::Lqg(_));
+    let horizon = cfg
+        .env
+        .time_limit()
+        .map_or(cfg.horizon, |l| l.min(cfg.horizon));
+    ProvenWidths::new(k.r_max(), non_positive, k.m_phi(), k.gamma(), horizon)
+        .map_err(|e| ConfigError::Environment(e.to_string()))
 }
 
 /// The settings of a run whose trajectories are collected outside the crate by a

@@ -1,6 +1,7 @@
 //! Monte Carlo J and gradients: deterministic rollouts (`sepg_mdp::rollout`) and the
 //! estimators of `sepg_estimators` with Student-t confidence widths (Sec 4.5).
 use sepg_bounds::constants::{TaskConstants, c as penalty_c, dc_dsigma};
+use sepg_estimators::proven::ProvenWidths;
 use sepg_estimators::{
     Estimate, Estimator, GradientSpec, Param, SurrogateEstimate, student_t_quantile,
 };
@@ -43,6 +44,7 @@ pub(crate) struct SampledSource {
 /// rollout engine or from a [`BatchCollector`]. Buffers are reused across calls.
 pub struct BlockEstimator {
     spec: GradientSpec,
+    proven: Option<Proven>,
     constants: TaskConstants,
     estimator: Estimator,
     value: Estimate,
@@ -134,6 +136,40 @@ impl StudentT {
     }
 }
 
+/// Proven widths (`Confidence::SubGaussian`): the gradients a guarantee rests on are
+/// estimated by G(PO)MDP with the constant baseline of `widths`, and each component's width is
+/// the proven one at level `delta` (`sepg_estimators::proven`).
+#[derive(Debug, Clone)]
+struct Proven {
+    widths: ProvenWidths,
+    delta: f64,
+}
+
+impl Proven {
+    /// The mean of `e` (an estimate of ∇_v J or ∇_w J from `n` trajectories) and the proven
+    /// half-widths of its components; `sigma` are the batch's σ_j (a mean component
+    /// `j · p + i` uses σ_j).
+    fn grad(&self, e: &Estimate, param: Param, sigma: &[f64]) -> Result<Grad, RunError> {
+        let (n, m) = (e.n(), e.dim());
+        let eps: Result<Vec<f64>, _> = match param {
+            Param::V => {
+                let p = (m / sigma.len().max(1)).max(1);
+                (0..m)
+                    .map(|i| {
+                        let s = sigma.get(i / p).copied().unwrap_or(f64::NAN);
+                        self.widths.v_width(s, n, self.delta)
+                    })
+                    .collect()
+            }
+            Param::W => (0..m).map(|_| self.widths.w_width(n, self.delta)).collect(),
+        };
+        Ok(Grad {
+            value: e.mean().to_vec(),
+            eps: eps.map_err(ee)?,
+        })
+    }
+}
+
 /// Unbiased sample variance of `x` (n ≥ 2).
 fn sample_variance(x: &[f64]) -> f64 {
     let n = x.len() as f64;
@@ -163,6 +199,12 @@ impl SampledSource {
         }
     }
 
+    /// The same source with proven widths (see [`BlockEstimator::with_proven_widths`]).
+    pub(crate) fn with_proven_widths(mut self, widths: ProvenWidths, delta: f64) -> Self {
+        self.estimator = self.estimator.with_proven_widths(widths, delta);
+        self
+    }
+
     /// The same source with the scores of its rollouts evaluated at the action chosen by
     /// `score` (raw by default).
     pub(crate) fn with_score_action(mut self, score: ScoreAction) -> Self {
@@ -177,6 +219,7 @@ impl BlockEstimator {
     pub fn new(delta: f64, spec: GradientSpec, constants: TaskConstants) -> Self {
         BlockEstimator {
             spec,
+            proven: None,
             constants,
             estimator: Estimator::new(),
             value: Estimate::new(),
@@ -189,6 +232,15 @@ impl BlockEstimator {
                 scales: Vec::new(),
             },
         }
+    }
+
+    /// The same estimator with the gradients a guarantee rests on (∇_v J, ∇_w J) estimated by
+    /// G(PO)MDP with the constant baseline of `widths` and given their proven widths at level
+    /// `delta` (the confidence option `SubGaussian`); the direction ∇̂_w L and J keep their
+    /// estimator and Student-t widths.
+    pub fn with_proven_widths(mut self, widths: ProvenWidths, delta: f64) -> Self {
+        self.proven = Some(Proven { widths, delta });
+        self
     }
 
     /// The same estimator with every width multiplied by `factor` ≥ 0 (the confidence
@@ -233,10 +285,17 @@ impl BlockEstimator {
         self.estimator.value(batch, &mut self.value).map_err(ee)?;
         let j = self.value.mean()[0];
         let mut grad = |param| -> Result<Grad, RunError> {
+            let spec = match &self.proven {
+                Some(p) => p.widths.gradient_spec(),
+                None => self.spec,
+            };
             self.estimator
-                .gradient(batch, param, self.spec, &mut self.grad)
+                .gradient(batch, param, spec, &mut self.grad)
                 .map_err(ee)?;
-            self.widths.grad(&self.grad)
+            match &self.proven {
+                Some(p) => p.grad(&self.grad, param, &batch.sigma),
+                None => self.widths.grad(&self.grad),
+            }
         };
         let grad_v = need.grad_v.then(|| grad(Param::V)).transpose()?;
         let grad_wj = need.grad_wj.then(|| grad(Param::W)).transpose()?;
