@@ -10,7 +10,7 @@ use pyo3::types::PyModule;
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
-use sepg_algo::core::options::{Schedule, SepgOptions};
+use sepg_algo::core::options::{Confidence, Schedule, SepgOptions};
 use sepg_algo::core::seed::Block;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
@@ -319,9 +319,10 @@ impl Trainer {
             error: Arc::clone(&error),
         };
         // the trainer knows no iteration count, so δ is not spread over a run: every width is
-        // at level δ (docs/THEOREMS.md, "Statements over a whole run")
+        // at level δ, Student-t (docs/THEOREMS.md, "Statements over a whole run")
         let mut options = SepgOptions {
             schedule: Schedule::Iteration,
+            confidence: Confidence::StudentT { factor: 1.0 },
             ..SepgOptions::default()
         };
         if let Some(n0) = reference_batch {

@@ -1289,7 +1289,7 @@ mod tests {
         .resolve()
         .expect("valid");
         assert_eq!(plain.spec.w_step, Some(WStepName::Exploring));
-        assert_eq!(plain.spec.confidence, Some(ConfidenceName::StudentT));
+        assert_eq!(plain.spec.confidence, Some(ConfidenceName::SubGaussian));
         assert_eq!(plain.spec.reference_batch, Some(1000));
         assert_eq!(plain.spec.lb1_requirement, None);
         assert_eq!(plain.checked.constants().psi_override(), None);

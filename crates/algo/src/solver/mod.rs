@@ -89,7 +89,8 @@ impl PolicySolver {
                     constants,
                 )
                 .with_score_action(cfg.score_action);
-                if cfg.options.confidence == Confidence::SubGaussian {
+                let sepg = matches!(cfg.algorithm, Algorithm::Sepg(_) | Algorithm::SepgNaiveW(_));
+                if sepg && cfg.options.confidence == Confidence::SubGaussian {
                     source = source.with_proven_widths(proven_widths(config)?, level);
                 }
                 Box::new(source)
@@ -240,12 +241,14 @@ impl PolicySolver {
     /// than the solver's (its widths are built for it).
     pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
         options.validate()?;
-        if options.schedule != self.options.schedule {
+        if options.schedule != self.options.schedule
+            || options.confidence != self.options.confidence
+        {
             // the widths were built for the solver's schedule
             return Err(ConfigError::UnsupportedOption {
-                option: "schedule",
-                reason: "the schedule is fixed when the solver is built (a collector solver \
-                         knows no iteration count: schedule iteration)",
+                option: "schedule/confidence",
+                reason: "the schedule and widths are fixed when the solver is built (a \
+                         collector solver: schedule iteration, Student-t widths)",
             });
         }
         self.options = options;
@@ -284,9 +287,11 @@ impl PolicySolver {
             dims,
             constants: config.constants,
             // No iteration count is known here, so δ cannot be spread over a run: every width
-            // is at level δ (per-iteration statements).
+            // is at level δ (per-iteration statements); no horizon or reward sign is known
+            // either, so the widths are Student-t.
             options: SepgOptions {
                 schedule: Schedule::Iteration,
+                confidence: Confidence::StudentT { factor: 1.0 },
                 ..SepgOptions::default()
             },
             source: Box::new(CollectedSource::new(

@@ -587,8 +587,9 @@ mod tests {
         };
         for algorithm in algorithms {
             let mut cfg = SepgConfig::new(sepg_mdp::env::Preset::Lqg1d.build(), algorithm);
-            // a collector run knows no iteration count: its widths are at level δ
+            // a collector run knows no iteration count: its widths are Student-t at level δ
             cfg.options.schedule = crate::core::options::Schedule::Iteration;
+            cfg.options.confidence = crate::core::options::Confidence::StudentT { factor: 1.0 };
             cfg.n_trajectories = 60;
             cfg.seed = 9;
             let checked = cfg.clone().check().expect("config");

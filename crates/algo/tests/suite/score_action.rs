@@ -5,7 +5,7 @@
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
-use sepg_algo::core::options::{Schedule, SepgOptions};
+use sepg_algo::core::options::{Confidence, Schedule, SepgOptions};
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
@@ -83,9 +83,10 @@ fn clipped_action_scores_reach_the_sampled_rollouts() {
             n_trajectories: 60,
             seed: 5,
             score_action: ScoreAction::Clipped,
-            // a collector run knows no iteration count: its widths are at level δ
+            // a collector run knows no iteration count: Student-t widths at level δ
             options: SepgOptions {
                 schedule: Schedule::Iteration,
+                confidence: Confidence::StudentT { factor: 1.0 },
                 ..SepgOptions::default()
             },
             ..SepgConfig::new(Preset::Lqg1d.build(), algorithm)
