@@ -1041,6 +1041,12 @@ impl Walk {
         let Some((v_next, w_next)) = &step.next else {
             return Ok(false);
         };
+        if plans
+            .iter()
+            .all(|p| matches!(p.name, "budget" | "budget-target"))
+        {
+            return Ok(true);
+        }
         let j_t = j(&row.v, &row.w)?;
         let j_mid = j(v_next, &row.w)?;
         let j_next = j(v_next, w_next)?;
@@ -1402,8 +1408,13 @@ pub fn render(report: &AuditReport) -> String {
         "statement: {}, scope {}, δ = {}, covers {} ({})",
         kebab(&st.kind),
         kebab(&st.scope),
-        st.delta
-            .map_or_else(|| "none (certain)".to_owned(), |d| d.to_string()),
+        st.delta.map_or_else(
+            || match st.kind {
+                StatementKind::None => "-".to_owned(),
+                _ => "none (certain)".to_owned(),
+            },
+            |d| d.to_string()
+        ),
         kebab(&st.covers),
         if report.statement_recorded {
             "recorded"
