@@ -73,7 +73,7 @@ pub fn run(args: &AuditArgs) -> Result<(), CliError> {
     }
     match report.verdict {
         Verdict::Broken => Err(CliError::failure(format!(
-            "{} broke its promise: {}",
+            "{}: {}",
             args.dir.display(),
             report.reason
         ))),

@@ -235,7 +235,7 @@ pub struct CheckSummary {
     /// The longest run of consecutive failing iterations.
     pub longest_run: u64,
     /// Largest `required − actual` over the checked iterations (negative: the smallest margin
-    /// by which it held).
+    /// by which it held; 0 when no iteration could fail, e.g. no step taken).
     pub worst_shortfall: f64,
     /// Iteration of the worst shortfall.
     pub worst_iteration: u64,
@@ -1291,7 +1291,11 @@ fn verdict(
     (done, complete): (u64, bool),
     exact: bool,
 ) -> (Verdict, String) {
-    if let Some(c) = checks.iter().find(|c| c.judgement == Judgement::Broken) {
+    let first_broken = checks
+        .iter()
+        .filter(|c| c.judgement == Judgement::Broken)
+        .min_by_key(|c| c.first_failure.unwrap_or(u64::MAX));
+    if let Some(c) = first_broken {
         let first = failures.iter().find(|f| f.check == c.check);
         let why = match (c.test, first) {
             (Test::OneFailure, Some(f)) => format!(
