@@ -930,6 +930,10 @@ fn every_malformed_or_incomplete_folder_exits_with_status_2() {
     )
     .expect("write");
     assert_malformed(&dir, "reports 11 iterations");
+    let mut bad_delta: serde_json::Value = serde_json::from_str(&s).expect("json");
+    bad_delta["statement"]["delta"] = 1.5.into();
+    fs::write(&summary, bad_delta.to_string()).expect("write");
+    assert_malformed(&dir, "the statement's delta 1.5 is not in (0, 1)");
     fs::write(&summary, &s).expect("restore");
     assert_eq!(sepg(&["audit", path(&dir)]).status.code(), Some(0));
 }

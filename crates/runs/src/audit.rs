@@ -1201,6 +1201,14 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
     };
     let (statement, statement_recorded) =
         judged_statement(progress.summary.as_ref(), resolved.checked.statement());
+    if let Some(d) = statement.delta
+        && !(d > 0.0 && d < 1.0)
+    {
+        return Err(bad(
+            dir,
+            format!("{SUMMARY_FILE}: the statement's delta {d} is not in (0, 1)"),
+        ));
+    }
     let self_check = progress.summary.as_ref().and_then(|s| s.self_check);
     let mut plans = plans(requirement, &statement, resolved.dims);
     if exact.is_none() {
