@@ -2043,7 +2043,7 @@ mod tests {
             let error = (d_audit - (jb - ja)).abs();
             assert!(
                 error <= tolerance / 10.0,
-                "{preset} v = {v} σ = {sigma} ({dv}, {dw}): error {error:e}, tolerance {tolerance:e}"
+                "{preset} v = {v} σ = {sigma} ({dv}, {dw}): error {error:e}, tol. {tolerance:e}"
             );
         }
         assert!(largest_tolerance < 1e-9 / 2.0, "{largest_tolerance:e}");
