@@ -609,8 +609,7 @@ pub struct RunAudit {
     /// Run folder relative to the sweep folder.
     pub dir: String,
     /// The run's verdict ([`crate::audit::Verdict::name`]), or `malformed` (invalid folder) or
-    /// `error`
-    /// (the audit could not run).
+    /// `error` (the audit could not run).
     pub verdict: String,
     /// Whether the run failed what its statement states (counted in its group).
     pub failed: bool,
