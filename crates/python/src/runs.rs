@@ -293,11 +293,11 @@ fn merge_folders(
     serialize_to_py(py, &file)
 }
 
-/// Re-checks the log of the run folder `dir` against its safety requirement (with the exact
-/// oracle where one exists) and returns the report of `sepg audit` as a dict; `alpha` is
-/// the family-wise level of the binomial tests of a sampled run.
+/// Re-checks the log of the run folder `dir` against exactly what its statement promises
+/// (with the exact oracle where one exists) and returns the report of `sepg audit` as a dict;
+/// `tolerance` is relative to max(1, |J|), `alpha` the family-wise level of the tests.
 #[pyfunction]
-#[pyo3(signature = (dir, tolerance = 1e-9, alpha = sepg_runs::audit::DEFAULT_ALPHA))]
+#[pyo3(signature = (dir, tolerance = sepg_runs::audit::DEFAULT_TOLERANCE, alpha = sepg_runs::audit::DEFAULT_ALPHA))]
 fn audit_folder(
     py: Python<'_>,
     dir: PathBuf,

@@ -28,6 +28,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, audit, broken_runs_p_value};
 use crate::error::{Error, Result};
 use crate::folder::{CONFIG_FILE, check_out_dir, is_complete, to_json_line, write_atomic};
 use crate::run::{self, Observer, RunOptions, Silent};
@@ -538,38 +539,35 @@ pub const SUMMARY_CSV_HEADER: &str =
 /// Writes [`SUMMARY_CSV`] in the sweep folder `dir`: one row per run of its shard, in sweep
 /// order, with the preset, variant, algorithm, σ⁰, seed, final v and σ (components joined by
 /// `;`), the last logged J of the exploratory policy, max_i |v_i − v*_i| (LQG), the number of
-/// infeasible iterations and, with `audit`, the status of `sepg audit` at its defaults
-/// (`holds`, `violated`, `incomplete`, or `malformed` / `error` when the audit could not run;
-/// without `audit`: `not-audited`, since recomputing exact J costs several times the run
-/// itself). Runs are audited in parallel; the file is replaced atomically. Returns the audit
-/// status of each run, in sweep order.
+/// infeasible iterations and, with `audit`, the verdict of `sepg audit` at its defaults
+/// ([`audit_sweep`]; without `audit`: `not-audited`, since recomputing exact J costs several
+/// times the run itself). The file is replaced atomically. Returns the audit column of each
+/// run, in sweep order.
 ///
 /// # Errors
 /// [`Error::Failed`] when a finished run's summary cannot be read or the file cannot be
 /// written.
 pub fn write_summary_csv(dir: &Path, file: &SweepFile, audit: bool) -> Result<Vec<String>> {
-    use crate::audit::{DEFAULT_ALPHA, Status, audit as run_audit};
+    if audit {
+        let audited = audit_sweep(dir, file, DEFAULT_TOLERANCE, DEFAULT_ALPHA)?;
+        return Ok(audited.runs.into_iter().map(|r| r.verdict).collect());
+    }
+    let verdicts = vec!["not-audited".to_owned(); file.shard_runs().count()];
+    summary_csv(dir, file, &verdicts)?;
+    Ok(verdicts)
+}
+
+/// Writes [`SUMMARY_CSV`] with the audit column `verdicts` (one per run, in sweep order).
+fn summary_csv(dir: &Path, file: &SweepFile, verdicts: &[String]) -> Result<()> {
     use crate::folder::{load_resolved, read_summary};
     let runs: Vec<&RunEntry> = file.shard_runs().collect();
     let rows: Vec<Result<String>> = runs
         .par_iter()
-        .map(|r| {
+        .zip(verdicts)
+        .map(|(r, verdict)| {
             let run_dir = dir.join(&r.dir);
             let summary = read_summary(&run_dir)?;
             let algorithm = load_resolved(&run_dir)?.spec.algo.map_or("", |a| a.name());
-            let status = if audit {
-                match run_audit(&run_dir, 1e-9, DEFAULT_ALPHA) {
-                    Ok(a) => match a.status {
-                        Status::Holds => "holds",
-                        Status::Violated => "violated",
-                        _ => "incomplete",
-                    },
-                    Err(e) if e.is_invalid_input() => "malformed",
-                    Err(_) => "error",
-                }
-            } else {
-                "not-audited"
-            };
             let join = |xs: &[f64]| {
                 xs.iter()
                     .map(|x| format!("{x:?}"))
@@ -578,7 +576,7 @@ pub fn write_summary_csv(dir: &Path, file: &SweepFile, audit: bool) -> Result<Ve
             };
             let opt = |x: Option<f64>| x.map(|x| format!("{x:?}")).unwrap_or_default();
             Ok(format!(
-                "{},{},{algorithm},{:?},{},{},{},{},{},{},{status}\n",
+                "{},{},{algorithm},{:?},{},{},{},{},{},{},{verdict}\n",
                 r.preset.name(),
                 r.variant,
                 r.sigma0,
@@ -592,20 +590,227 @@ pub fn write_summary_csv(dir: &Path, file: &SweepFile, audit: bool) -> Result<Ve
         })
         .collect();
     let mut text = format!("{SUMMARY_CSV_HEADER}\n");
-    let mut statuses = Vec::new();
     for row in rows {
-        let row = row?;
-        statuses.push(
-            row.trim_end()
-                .rsplit(',')
-                .next()
-                .unwrap_or_default()
-                .to_owned(),
-        );
-        text.push_str(&row);
+        text.push_str(&row?);
     }
-    write_atomic(&dir.join(SUMMARY_CSV), text.as_bytes())?;
-    Ok(statuses)
+    write_atomic(&dir.join(SUMMARY_CSV), text.as_bytes())
+}
+
+/// Group verdicts of `sepg audit SWEEP_DIR`: one row per (preset, variant, σ⁰).
+pub const AUDIT_GROUPS_CSV: &str = "audit-groups.csv";
+
+/// The header of [`AUDIT_GROUPS_CSV`].
+pub const AUDIT_GROUPS_HEADER: &str =
+    "preset,variant,sigma0,runs,failed,rate,p_value,level,verdict";
+
+/// The audit of one run of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunAudit {
+    /// Run folder relative to the sweep folder.
+    pub dir: String,
+    /// The run's verdict ([`crate::audit::Verdict::name`]), or `malformed` (invalid folder) or
+    /// `error` (the audit could not run).
+    pub verdict: String,
+    /// Whether the run failed what its statement states (counted in its group).
+    pub failed: bool,
+    /// The probability, under its statement, that the run is found failed
+    /// ([`crate::audit::AuditReport::null_rate`]); `None` when nothing is tested.
+    pub rate: Option<f64>,
+}
+
+/// The verdict on a group of runs that differ only in their seed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum GroupVerdict {
+    /// Proven statements: the number of failed runs is consistent with their rate.
+    Consistent,
+    /// Proven statements: the exact binomial test rejects the number of failed runs at the
+    /// Bonferroni level α / (number of tested groups).
+    Rejected,
+    /// Approximate statements: the count and its p-value are reported, not judged.
+    Approximate,
+    /// The runs state nothing about exact J.
+    NoGuarantee,
+    /// No exact oracle: not checked against exact J.
+    NotChecked,
+    /// A run is unfinished, malformed or could not be audited.
+    Incomplete,
+}
+
+impl GroupVerdict {
+    /// The name in [`AUDIT_GROUPS_CSV`] and the printed lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            GroupVerdict::Consistent => "consistent",
+            GroupVerdict::Rejected => "rejected",
+            GroupVerdict::Approximate => "approximate",
+            GroupVerdict::NoGuarantee => "no-guarantee",
+            GroupVerdict::NotChecked => "not-checked",
+            GroupVerdict::Incomplete => "incomplete",
+        }
+    }
+}
+
+/// The test of one (preset, variant, σ⁰) group of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GroupAudit {
+    /// Environment.
+    pub preset: String,
+    /// Variant name.
+    pub variant: String,
+    /// Initial standard deviation.
+    pub sigma0: f64,
+    /// Runs (seeds) in the group.
+    pub runs: u64,
+    /// Runs that failed what their statement states.
+    pub failed: u64,
+    /// The probability with which each run may fail under its statement (0 for exact
+    /// gradients, δ for scope `run`, α for scope `iteration`); `None` when untested.
+    pub rate: Option<f64>,
+    /// P(Binomial(runs, rate) ≥ failed).
+    pub p_value: Option<f64>,
+    /// The Bonferroni level the p-value is compared with: α / (number of tested groups).
+    pub level: Option<f64>,
+    /// The verdict.
+    pub verdict: GroupVerdict,
+}
+
+/// The audit of a sweep: every run, and every group.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepAudit {
+    /// The runs, in sweep order.
+    pub runs: Vec<RunAudit>,
+    /// The groups, in order of their first run.
+    pub groups: Vec<GroupAudit>,
+}
+
+/// Audits every run of the sweep folder `dir` (in parallel) with relative tolerance
+/// `tolerance` and level `alpha` ([`crate::audit::audit`]), writes their verdicts into the
+/// audit column of [`SUMMARY_CSV`], and tests each (preset, variant, σ⁰) group: its runs are
+/// independent (they differ only in their seed), each failing with probability at most
+/// `rate` under its statement, so the number of failed runs is at most Binomial(n, rate); the
+/// group is rejected when P(Binomial(n, rate) ≥ failed) < α / G, G the number of groups with
+/// proven statements (Bonferroni). The group verdicts go to [`AUDIT_GROUPS_CSV`].
+///
+/// # Errors
+/// [`Error::Invalid`] for a tolerance or level out of range; [`Error::Failed`] when a finished
+/// run's summary cannot be read or a file cannot be written.
+pub fn audit_sweep(dir: &Path, file: &SweepFile, tolerance: f64, alpha: f64) -> Result<SweepAudit> {
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(Error::invalid(format!(
+            "--tolerance {tolerance} must be finite and >= 0"
+        )));
+    }
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(Error::invalid(format!("--alpha {alpha} must be in (0, 1)")));
+    }
+    let entries: Vec<&RunEntry> = file.shard_runs().collect();
+    let runs: Vec<RunAudit> = entries
+        .par_iter()
+        .map(|r| match audit(&dir.join(&r.dir), tolerance, alpha) {
+            Ok(a) => RunAudit {
+                dir: r.dir.clone(),
+                verdict: a.verdict.name().to_owned(),
+                failed: a.statement_failed(),
+                rate: a.null_rate(),
+            },
+            Err(e) => RunAudit {
+                dir: r.dir.clone(),
+                verdict: if e.is_invalid_input() {
+                    "malformed"
+                } else {
+                    "error"
+                }
+                .to_owned(),
+                failed: false,
+                rate: None,
+            },
+        })
+        .collect();
+    let verdicts: Vec<String> = runs.iter().map(|r| r.verdict.clone()).collect();
+    summary_csv(dir, file, &verdicts)?;
+    let mut keys: Vec<(EnvName, &str, u64)> = Vec::new();
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for (i, r) in entries.iter().enumerate() {
+        let k = (r.preset, r.variant.as_str(), r.sigma0.to_bits());
+        match keys.iter().position(|x| *x == k) {
+            Some(g) => members[g].push(i),
+            None => {
+                keys.push(k);
+                members.push(vec![i]);
+            }
+        }
+    }
+    let mut groups = Vec::new();
+    for ((preset, variant, sigma0), idx) in keys.iter().zip(&members) {
+        let of: Vec<&RunAudit> = idx.iter().map(|&i| &runs[i]).collect();
+        let n = of.len() as u64;
+        let failed = of.iter().filter(|r| r.failed).count() as u64;
+        let has = |v: &str| of.iter().any(|r| r.verdict == v);
+        let unfinished = ["incomplete", "malformed", "error"].iter().any(|v| has(v));
+        let rate = of
+            .iter()
+            .map(|r| r.rate)
+            .try_fold(0.0f64, |m, r| r.map(|r| m.max(r)));
+        let (verdict, p_value) = match rate {
+            _ if unfinished => (GroupVerdict::Incomplete, None),
+            Some(rate) => {
+                let p = broken_runs_p_value(failed, n, rate)?;
+                let v = if has("approximate") {
+                    GroupVerdict::Approximate
+                } else {
+                    GroupVerdict::Consistent
+                };
+                (v, Some(p))
+            }
+            None if has("not-checked") => (GroupVerdict::NotChecked, None),
+            None => (GroupVerdict::NoGuarantee, None),
+        };
+        groups.push(GroupAudit {
+            preset: preset.name().to_owned(),
+            variant: (*variant).to_owned(),
+            sigma0: f64::from_bits(*sigma0),
+            runs: n,
+            failed,
+            rate: rate.filter(|_| p_value.is_some()),
+            p_value,
+            level: None,
+            verdict,
+        });
+    }
+    let tested = groups
+        .iter()
+        .filter(|g| g.verdict == GroupVerdict::Consistent)
+        .count()
+        .max(1);
+    let level = alpha / tested as f64;
+    for g in &mut groups {
+        if let Some(p) = g.p_value {
+            g.level = Some(level);
+            if g.verdict == GroupVerdict::Consistent && p < level {
+                g.verdict = GroupVerdict::Rejected;
+            }
+        }
+    }
+    let opt = |x: Option<f64>| x.map(|x| format!("{x:?}")).unwrap_or_default();
+    let mut text = format!("{AUDIT_GROUPS_HEADER}\n");
+    for g in &groups {
+        text.push_str(&format!(
+            "{},{},{:?},{},{},{},{},{},{}\n",
+            g.preset,
+            g.variant,
+            g.sigma0,
+            g.runs,
+            g.failed,
+            opt(g.rate),
+            opt(g.p_value),
+            opt(g.level),
+            g.verdict.name()
+        ));
+    }
+    write_atomic(&dir.join(AUDIT_GROUPS_CSV), text.as_bytes())?;
+    Ok(SweepAudit { runs, groups })
 }
 
 #[cfg(test)]

@@ -186,10 +186,11 @@ def merge(shards: Sequence[PathLike], out: PathLike, *, force: bool = False) -> 
     return _native.merge_folders([os.fspath(s) for s in shards], os.fspath(out), force)
 
 
-def audit(dir: PathLike, *, tolerance: float = 1e-9, alpha: float = 0.01) -> Dict[str, Any]:
-    """Re-checks the run folder's log against its safety requirement, as ``sepg audit``:
-    the report has each check with its failures and a ``status``; ``alpha`` is the
-    family-wise level of the binomial tests of a sampled run."""
+def audit(dir: PathLike, *, tolerance: float = 1e-12, alpha: float = 0.01) -> Dict[str, Any]:
+    """Re-checks the run folder's log against exactly what its statement promises, as
+    ``sepg audit``: the report has each check with its failures and a ``verdict`` (``holds``,
+    ``broken``, ``approximate``, ``no-guarantee``, ``not-checked``, ``incomplete``);
+    ``tolerance`` is relative to max(1, |J|), ``alpha`` the family-wise level of the tests."""
     return _native.audit_folder(os.fspath(dir), tolerance, alpha)
 
 
