@@ -7,10 +7,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::executor::Solver;
 use sepg_algo::solver::PolicySolver;
-use sepg_bounds::certified;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HpForm};
 use sepg_bounds::{exploring, v_update, w_update};
+use sepg_certified as certified;
 use sepg_mdp::env::Preset;
 use std::hint::black_box;
 

@@ -31,7 +31,8 @@
 
 use crate::constants::{TaskConstants, d};
 use crate::error::{BoundsError, finite, no_overflow, non_negative};
-use crate::outcome::{SafeInterval, StepOutcome, solve_quadratic};
+use crate::outcome::{SafeInterval, StepOutcome};
+use crate::parabola::Parabola;
 
 /// The lower bound B(Δw) of the exploring w-update for an estimate ∇̂_w J with half-width ε_J.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,8 +152,8 @@ impl ExploringBound {
     pub fn safe_interval(&self, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("required", required)?;
         let (vertex, c_max) = self.vertex()?;
-        let positive = solve_quadratic(self.grad_w_j_hat - self.eps_j, self.d, required)?;
-        let negative = solve_quadratic(self.grad_w_j_hat + self.eps_j, self.d, required)?;
+        let positive = Parabola::new(self.grad_w_j_hat - self.eps_j, self.d).solve(required)?;
+        let negative = Parabola::new(self.grad_w_j_hat + self.eps_j, self.d).solve(required)?;
         let side = |o: StepOutcome, keep: fn(f64, f64) -> Option<(f64, f64)>| match o {
             StepOutcome::Feasible(s) => keep(s.lo, s.hi),
             _ => None,
@@ -221,12 +222,20 @@ pub fn w_exploring_step(
 }
 
 impl ExploringBound {
-    /// The exploring step along ∇̂_w L for this bound: the body of [`w_exploring_step`].
-    pub(crate) fn step_along(
-        &self,
-        grad_w_l_hat: f64,
-        required: f64,
-    ) -> Result<StepOutcome, BoundsError> {
+    /// The exploring step along ∇̂_w L for this bound: [`w_exploring_step`] without
+    /// evaluating d(σ) again.
+    ///
+    /// Errors: non-finite ∇̂_w L or `required`, and [`BoundsError::Overflow`] when β is not
+    /// representable.
+    ///
+    /// ```
+    /// use sepg_bounds::{constants::TaskConstants, exploring::{ExploringBound, w_exploring_step}};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let b = ExploringBound::new(&k, 1.0, -0.3, 0.1)?;
+    /// assert_eq!(b.step_along(0.4, -0.01)?, w_exploring_step(&k, 1.0, -0.3, 0.1, 0.4, -0.01)?);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn step_along(&self, grad_w_l_hat: f64, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("grad_w_l_hat", grad_w_l_hat)?;
         finite("required", required)?;
         if grad_w_l_hat == 0.0 {

@@ -18,12 +18,11 @@
 //! −|x|·a⁺. For C < 0 the printed intervals (4.26), (4.29), (4.30) reach that side, so the
 //! sign-aware form is the one that keeps the guarantee there.
 
-use crate::constants::{TaskConstants, c, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow, non_negative};
-use crate::outcome::{
-    SafeInterval, StepOutcome, feasible_interval, feasible_sign_aware, solve_quadratic,
-    solve_sign_aware,
-};
+use crate::outcome::{SafeInterval, StepOutcome};
+use crate::parabola::{Parabola, feasible_sign_aware, solve_sign_aware};
+use crate::penalties::Penalties;
 
 /// Lower- and upper-corrected gradient norms of Section 4.5.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,15 +112,17 @@ impl HighProbabilityBound {
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::v_update_with_c(c(k, sigma)?, grad_v_hat, eps)
+        Self::v_update_at(&Penalties::thesis(k, sigma)?, grad_v_hat, eps)
     }
 
-    /// [`Self::v_update`] for a given c(σ).
-    pub(crate) fn v_update_with_c(
-        cc: f64,
+    /// [`Self::v_update`] for penalties evaluated once ([`Penalties`]), with c = `p.c()`.
+    #[inline]
+    pub fn v_update_at(
+        p: &Penalties,
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let cc = p.c()?;
         let Some(n) = corrected_norm(grad_v_hat, eps)? else {
             return Ok(None);
         };
@@ -149,15 +150,17 @@ impl HighProbabilityBound {
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::w_along_j_with_d(d(k, sigma)?, grad_w_j_hat, eps)
+        Self::w_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j_hat, eps)
     }
 
-    /// [`Self::w_along_j`] for a given d(σ).
-    pub(crate) fn w_along_j_with_d(
-        dd: f64,
+    /// [`Self::w_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+    #[inline]
+    pub fn w_along_j_at(
+        p: &Penalties,
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let dd = p.d()?;
         let Some(n) = corrected_norm(&[grad_w_j_hat], eps)? else {
             return Ok(None);
         };
@@ -191,17 +194,25 @@ impl HighProbabilityBound {
         grad_w_l_hat: f64,
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::w_along_l_with_d(d(k, sigma)?, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)
+        Self::w_along_l_at(
+            &Penalties::thesis(k, sigma)?,
+            grad_w_j_hat,
+            eps_j,
+            grad_w_l_hat,
+            eps_l,
+        )
     }
 
-    /// [`Self::w_along_l`] for a given d(σ).
-    pub(crate) fn w_along_l_with_d(
-        dd: f64,
+    /// [`Self::w_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+    #[inline]
+    pub fn w_along_l_at(
+        p: &Penalties,
         grad_w_j_hat: f64,
         eps_j: f64,
         grad_w_l_hat: f64,
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let dd = p.d()?;
         let nj = corrected_norm(&[grad_w_j_hat], eps_j)?;
         let nl = corrected_norm(&[grad_w_l_hat], eps_l)?;
         let (Some(nj), Some(nl)) = (nj, nl) else {
@@ -348,7 +359,7 @@ impl HighProbabilityBound {
         finite("required", required)?;
         match form {
             HpForm::Thesis => {
-                solve_quadratic(self.direction * self.linear_lower, self.quadratic, required)
+                Parabola::new(self.direction * self.linear_lower, self.quadratic).solve(required)
             }
             HpForm::SignAware => solve_sign_aware(
                 self.direction,
@@ -360,13 +371,13 @@ impl HighProbabilityBound {
         }
     }
 
-    /// The interval of [`Self::safe_step`] when it returns a feasible one, else `None`
-    /// (`outcome::feasible_interval`).
+    /// The interval of [`Self::safe_step`] when it returns a feasible one, bit for bit, else
+    /// `None` (see [`Parabola::feasible`]).
     #[inline(always)]
-    pub(crate) fn feasible_step(&self, required: f64, form: HpForm) -> Option<SafeInterval> {
+    pub fn feasible_step(&self, required: f64, form: HpForm) -> Option<SafeInterval> {
         match form {
             HpForm::Thesis => {
-                feasible_interval(self.direction * self.linear_lower, self.quadratic, required)
+                Parabola::new(self.direction * self.linear_lower, self.quadratic).feasible(required)
             }
             HpForm::SignAware => feasible_sign_aware(
                 self.direction,

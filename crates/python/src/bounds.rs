@@ -8,17 +8,18 @@
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use sepg_bounds::budget::{self, Budget};
-use sepg_bounds::certified::{
-    self, Certified, EnclosedBound, ExploringEnclosure, HpEnclosure, Quadratic, RigorousEnclosure,
-};
 use sepg_bounds::exploring::{self, ExploringBound};
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
-use sepg_bounds::interval::Interval;
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::pirotta::AdaptiveStep;
 use sepg_bounds::{
     BoundsError, batch_size, constants, greedy, papini, pirotta, rigorous, surrogate, v_update,
     w_update,
+};
+use sepg_certified::Interval;
+use sepg_certified::{
+    self as certified, Certified, EnclosedBound, ExploringEnclosure, HpEnclosure, Quadratic,
+    RigorousEnclosure,
 };
 
 use crate::{PyTaskConstants, invalid, vector};

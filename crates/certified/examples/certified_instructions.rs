@@ -7,10 +7,10 @@
 //!
 //! STEP is one of `v`, `w_l`, `hp_v`, `exploring` (the steps of the `certified` criterion bench, with
 //! the same inputs). Instructions per call = (count at N₁ − count at N₀)/(N₁ − N₀).
-use sepg_bounds::certified;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HpForm};
 use sepg_bounds::{exploring, v_update, w_update};
+use sepg_certified as certified;
 use std::hint::black_box;
 
 fn main() {
