@@ -29,10 +29,11 @@
 //! third-order term for Δw < 0 (ERRATA §10); on the LQG presets at γ = 0.99 it is
 //! conservative for σ ≥ 0.1.
 
-use crate::constants::{TaskConstants, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, no_overflow, non_negative};
 use crate::outcome::{SafeInterval, StepOutcome};
 use crate::parabola::Parabola;
+use crate::penalties::Penalties;
 
 /// The lower bound B(Δw) of the exploring w-update for an estimate ∇̂_w J with half-width ε_J.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,7 +50,7 @@ impl ExploringBound {
     /// The bound for the task `k` at standard deviation `sigma`.
     ///
     /// # Errors
-    /// Non-finite ∇̂_w J, ε_J < 0 or non-finite, and the errors of [`d`].
+    /// Non-finite ∇̂_w J, ε_J < 0 or non-finite, and the errors of [`d`](crate::constants::d).
     ///
     /// ```
     /// use sepg_bounds::{constants::{TaskConstants, d}, exploring::ExploringBound};
@@ -65,10 +66,18 @@ impl ExploringBound {
         grad_w_j_hat: f64,
         eps_j: f64,
     ) -> Result<Self, BoundsError> {
+        finite("grad_w_j_hat", grad_w_j_hat)?;
+        non_negative("eps_j", eps_j)?;
+        Self::at(&Penalties::thesis(k, sigma)?, grad_w_j_hat, eps_j)
+    }
+
+    /// [`ExploringBound::new`] for penalties evaluated once ([`Penalties`]), with
+    /// d = `p.d()` of their family; the same errors, without validating σ again.
+    pub fn at(p: &Penalties, grad_w_j_hat: f64, eps_j: f64) -> Result<Self, BoundsError> {
         Ok(ExploringBound {
             grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
             eps_j: non_negative("eps_j", eps_j)?,
-            d: d(k, sigma)?,
+            d: p.d()?,
         })
     }
 
@@ -193,7 +202,7 @@ impl ExploringBound {
 /// |∇̂_w J| ≤ ε_J blocks a step that the budget allows.
 ///
 /// # Errors
-/// Non-finite inputs, ε_J < 0, the errors of [`d`], and [`BoundsError::Overflow`] when β
+/// Non-finite inputs, ε_J < 0, the errors of [`d`](crate::constants::d), and [`BoundsError::Overflow`] when β
 /// is not representable (|∇̂_w L| below about 1e-300).
 ///
 /// ```
@@ -219,6 +228,18 @@ pub fn w_exploring_step(
 ) -> Result<StepOutcome, BoundsError> {
     let bound = ExploringBound::new(k, sigma, grad_w_j_hat, eps_j)?;
     bound.step_along(grad_w_l_hat, required)
+}
+
+/// [`w_exploring_step`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of
+/// their family; the same errors, without validating σ again.
+pub fn w_exploring_step_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
+    ExploringBound::at(p, grad_w_j_hat, eps_j)?.step_along(grad_w_l_hat, required)
 }
 
 impl ExploringBound {

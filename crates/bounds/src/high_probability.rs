@@ -432,8 +432,27 @@ pub fn v_safe_step(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
+    v_safe_step_at(
+        &Penalties::thesis(k, sigma)?,
+        grad_v_hat,
+        eps,
+        required,
+        form,
+    )
+}
+
+/// [`v_safe_step`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
+/// the same errors, without validating σ again.
+pub fn v_safe_step_at(
+    p: &Penalties,
+    grad_v_hat: &[f64],
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
     safe_step_or_below_noise(
-        HighProbabilityBound::v_update(k, sigma, grad_v_hat, eps)?,
+        HighProbabilityBound::v_update_at(p, grad_v_hat, eps)?,
         required,
         form,
     )
@@ -463,8 +482,27 @@ pub fn w_safe_step_along_j(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
+    w_safe_step_along_j_at(
+        &Penalties::thesis(k, sigma)?,
+        grad_w_j_hat,
+        eps,
+        required,
+        form,
+    )
+}
+
+/// [`w_safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
+/// the same errors, without validating σ again.
+pub fn w_safe_step_along_j_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
     safe_step_or_below_noise(
-        HighProbabilityBound::w_along_j(k, sigma, grad_w_j_hat, eps)?,
+        HighProbabilityBound::w_along_j_at(p, grad_w_j_hat, eps)?,
         required,
         form,
     )
@@ -499,8 +537,31 @@ pub fn w_safe_step_along_l(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
+    w_safe_step_along_l_at(
+        &Penalties::thesis(k, sigma)?,
+        grad_w_j_hat,
+        eps_j,
+        grad_w_l_hat,
+        eps_l,
+        required,
+        form,
+    )
+}
+
+/// [`w_safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
+/// the same errors, without validating σ again.
+pub fn w_safe_step_along_l_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    eps_l: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
     safe_step_or_below_noise(
-        HighProbabilityBound::w_along_l(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
+        HighProbabilityBound::w_along_l_at(p, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
         required,
         form,
     )

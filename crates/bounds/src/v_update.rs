@@ -3,7 +3,7 @@
 //! The update is the greedy-coordinate step (4.11) of size α on the coordinate with the largest
 //! |∇_{v_k} J|; every function takes the whole gradient ∇_v J and uses its ∞-norm.
 
-use crate::constants::{TaskConstants, c};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow};
 use crate::outcome::StepOutcome;
 use crate::parabola::Parabola;
@@ -24,7 +24,13 @@ use crate::penalties::Penalties;
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn alpha_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    no_overflow("alpha*", 0.5 / c(k, sigma)?)
+    alpha_star_at(&Penalties::thesis(k, sigma)?)
+}
+
+/// [`alpha_star`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn alpha_star_at(p: &Penalties) -> Result<f64, BoundsError> {
+    no_overflow("alpha*", 0.5 / p.c()?)
 }
 
 /// The largest guaranteed improvement of the v-update, eq. (4.9).
@@ -45,8 +51,17 @@ pub fn alpha_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 pub fn c_max(k: &TaskConstants, sigma: f64, grad_v: &[f64]) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     let n = inf_norm(grad_v);
+    no_overflow("||grad_v||^2", n * n)?;
+    c_max_at(&Penalties::thesis(k, sigma)?, grad_v)
+}
+
+/// [`c_max`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn c_max_at(p: &Penalties, grad_v: &[f64]) -> Result<f64, BoundsError> {
+    finite_vector("grad_v", grad_v)?;
+    let n = inf_norm(grad_v);
     let n2 = no_overflow("||grad_v||^2", n * n)?;
-    Parabola::new(n2, c(k, sigma)? * n2).c_max()
+    Parabola::new(n2, p.c()? * n2).c_max()
 }
 
 /// The lower bound (4.8) on J(v', w) − J(v, w) for a greedy-coordinate step of size α.
@@ -76,7 +91,15 @@ pub fn bound(
 ) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("alpha", alpha)?;
-    bound_with_c(c(k, sigma)?, grad_v, alpha, "Theorem 4.2 bound")
+    bound_at(&Penalties::thesis(k, sigma)?, grad_v, alpha)
+}
+
+/// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_at(p: &Penalties, grad_v: &[f64], alpha: f64) -> Result<f64, BoundsError> {
+    finite_vector("grad_v", grad_v)?;
+    finite("alpha", alpha)?;
+    bound_with_c(p.c()?, grad_v, alpha, "Theorem 4.2 bound")
 }
 
 /// α‖∇_vJ‖∞² − α²·cc·‖∇_vJ‖∞² for a validated gradient and step and a penalty coefficient cc

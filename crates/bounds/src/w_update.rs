@@ -5,7 +5,7 @@
 //! σ = e^w is the standard deviation *before* the update; `grad_w_j` is ∇_w J and `grad_w_l`
 //! is ∇_w L (the surrogate gradient of [`crate::surrogate`]), both at (v^{t+1}, w^t).
 
-use crate::constants::{TaskConstants, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, no_overflow};
 use crate::outcome::StepOutcome;
 use crate::parabola::Parabola;
@@ -26,7 +26,13 @@ use crate::penalties::Penalties;
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    no_overflow("beta*", 0.5 / d(k, sigma)?)
+    beta_star_at(&Penalties::thesis(k, sigma)?)
+}
+
+/// [`beta_star`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn beta_star_at(p: &Penalties) -> Result<f64, BoundsError> {
+    no_overflow("beta*", 0.5 / p.d()?)
 }
 
 /// The largest guaranteed improvement of the w-update, eq. (4.16) (also that of Theorem 4.5).
@@ -45,8 +51,16 @@ pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 /// ```
 pub fn c_max(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<f64, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
+    no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    c_max_at(&Penalties::thesis(k, sigma)?, grad_w_j)
+}
+
+/// [`c_max`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn c_max_at(p: &Penalties, grad_w_j: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    Parabola::new(g2, d(k, sigma)? * g2).c_max()
+    Parabola::new(g2, p.d()? * g2).c_max()
 }
 
 /// The lower bound (4.15) for the step Δw = β ∇_w J.
@@ -72,11 +86,17 @@ pub fn bound_along_j(
 ) -> Result<f64, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("beta", beta)?;
+    no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    bound_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j, beta)
+}
+
+/// [`bound_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_along_j_at(p: &Penalties, grad_w_j: f64, beta: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("beta", beta)?;
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    no_overflow(
-        "Theorem 4.3 bound",
-        beta * g2 - beta * beta * d(k, sigma)? * g2,
-    )
+    no_overflow("Theorem 4.3 bound", beta * g2 - beta * beta * p.d()? * g2)
 }
 
 /// The safe steps along ∇_w J for a required improvement νC (Theorem 4.3, eq. (4.17)).
@@ -176,12 +196,25 @@ pub fn bound_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("beta", beta)?;
+    no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
+    no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
+    bound_along_l_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l, beta)
+}
+
+/// [`bound_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_along_l_at(
+    p: &Penalties,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    beta: f64,
+) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("beta", beta)?;
     let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
     let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
-    no_overflow(
-        "Theorem 4.5 bound",
-        beta * lj - beta * beta * d(k, sigma)? * l2,
-    )
+    no_overflow("Theorem 4.5 bound", beta * lj - beta * beta * p.d()? * l2)
 }
 
 /// β̃ = ∇_w J / (2 d ∇_w L), the step along ∇_w L of maximal guaranteed improvement
@@ -216,7 +249,22 @@ pub fn beta_tilde(
             domain: "non-zero reals",
         });
     }
-    no_overflow("beta~", grad_w_j / (2.0 * d(k, sigma)? * grad_w_l))
+    beta_tilde_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l)
+}
+
+/// [`beta_tilde`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn beta_tilde_at(p: &Penalties, grad_w_j: f64, grad_w_l: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    if grad_w_l == 0.0 {
+        return Err(BoundsError::OutOfDomain {
+            name: "grad_w_l",
+            value: grad_w_l,
+            domain: "non-zero reals",
+        });
+    }
+    no_overflow("beta~", grad_w_j / (2.0 * p.d()? * grad_w_l))
 }
 
 /// The safe steps along ∇_w L for a required improvement νC (Theorem 4.5, eq. (4.19)).

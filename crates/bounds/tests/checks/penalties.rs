@@ -5,8 +5,9 @@
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use sepg_bounds::constants::{self, TaskConstants};
-use sepg_bounds::high_probability::HighProbabilityBound;
-use sepg_bounds::{BoundsError, Family, Penalties, v_update, w_update};
+use sepg_bounds::exploring::{self, ExploringBound};
+use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
+use sepg_bounds::{BoundsError, Family, Penalties, papini, pirotta, v_update, w_update};
 
 use super::common::c_ref;
 
@@ -93,6 +94,68 @@ proptest! {
         prop_assert_eq!(
             HighProbabilityBound::w_along_l_at(&p, grad, eps, grad_l, eps),
             HighProbabilityBound::w_along_l(&k, sigma, grad, eps, grad_l, eps)
+        );
+        let g = [grad, grad_l];
+        let bits = |r: Result<f64, BoundsError>| r.map(f64::to_bits);
+        prop_assert_eq!(bits(v_update::alpha_star_at(&p)), bits(v_update::alpha_star(&k, sigma)));
+        prop_assert_eq!(bits(v_update::c_max_at(&p, &g)), bits(v_update::c_max(&k, sigma, &g)));
+        prop_assert_eq!(
+            bits(v_update::bound_at(&p, &g, required)),
+            bits(v_update::bound(&k, sigma, &g, required))
+        );
+        prop_assert_eq!(bits(w_update::beta_star_at(&p)), bits(w_update::beta_star(&k, sigma)));
+        prop_assert_eq!(bits(w_update::c_max_at(&p, grad)), bits(w_update::c_max(&k, sigma, grad)));
+        prop_assert_eq!(
+            bits(w_update::bound_along_j_at(&p, grad, required)),
+            bits(w_update::bound_along_j(&k, sigma, grad, required))
+        );
+        prop_assert_eq!(
+            bits(w_update::bound_along_l_at(&p, grad, grad_l, required)),
+            bits(w_update::bound_along_l(&k, sigma, grad, grad_l, required))
+        );
+        prop_assert_eq!(
+            bits(w_update::beta_tilde_at(&p, grad, grad_l)),
+            bits(w_update::beta_tilde(&k, sigma, grad, grad_l))
+        );
+        prop_assert_eq!(
+            bits(pirotta::bound_at(&p, &g, required)),
+            bits(pirotta::bound(&k, sigma, &g, required))
+        );
+        prop_assert_eq!(pirotta::optimal_step_at(&p, &g), pirotta::optimal_step(&k, sigma, &g));
+        prop_assert_eq!(
+            bits(pirotta::hp_bound_at(&p, &g, &[eps, eps], required)),
+            bits(pirotta::hp_bound(&k, sigma, &g, &[eps, eps], required))
+        );
+        prop_assert_eq!(
+            pirotta::hp_optimal_step_at(&p, &g, &[eps, eps]),
+            pirotta::hp_optimal_step(&k, sigma, &g, &[eps, eps])
+        );
+        prop_assert_eq!(
+            bits(papini::bound_at(&p, &g, &[required, eps])),
+            bits(papini::bound(&k, sigma, &g, &[required, eps]))
+        );
+        prop_assert_eq!(papini::greedy_step_at(&p, &g), papini::greedy_step(&k, sigma, &g));
+        for form in [HpForm::Thesis, HpForm::SignAware] {
+            prop_assert_eq!(
+                hp::v_safe_step_at(&p, &g, eps, required, form),
+                hp::v_safe_step(&k, sigma, &g, eps, required, form)
+            );
+            prop_assert_eq!(
+                hp::w_safe_step_along_j_at(&p, grad, eps, required, form),
+                hp::w_safe_step_along_j(&k, sigma, grad, eps, required, form)
+            );
+            prop_assert_eq!(
+                hp::w_safe_step_along_l_at(&p, grad, eps, grad_l, eps, required, form),
+                hp::w_safe_step_along_l(&k, sigma, grad, eps, grad_l, eps, required, form)
+            );
+        }
+        prop_assert_eq!(
+            ExploringBound::at(&p, grad, eps),
+            ExploringBound::new(&k, sigma, grad, eps)
+        );
+        prop_assert_eq!(
+            exploring::w_exploring_step_at(&p, grad, eps, grad_l, required),
+            exploring::w_exploring_step(&k, sigma, grad, eps, grad_l, required)
         );
     }
 }
