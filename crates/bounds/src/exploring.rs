@@ -60,19 +60,23 @@ impl ExploringBound {
     /// assert!(ExploringBound::new(&k, 0.5, f64::NAN, 0.3).is_err());
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn new(
         k: &TaskConstants,
         sigma: f64,
         grad_w_j_hat: f64,
         eps_j: f64,
     ) -> Result<Self, BoundsError> {
-        finite("grad_w_j_hat", grad_w_j_hat)?;
-        non_negative("eps_j", eps_j)?;
-        Self::at(&Penalties::thesis(k, sigma)?, grad_w_j_hat, eps_j)
+        Ok(ExploringBound {
+            grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
+            eps_j: non_negative("eps_j", eps_j)?,
+            d: Penalties::thesis(k, sigma)?.d()?,
+        })
     }
 
     /// [`ExploringBound::new`] for penalties evaluated once ([`Penalties`]), with
     /// d = `p.d()` of their family; the same errors, without validating σ again.
+    #[inline]
     pub fn at(p: &Penalties, grad_w_j_hat: f64, eps_j: f64) -> Result<Self, BoundsError> {
         Ok(ExploringBound {
             grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
@@ -122,6 +126,7 @@ impl ExploringBound {
     /// assert_eq!(noisy.vertex()?, (0.0, 0.0));
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn vertex(&self) -> Result<(f64, f64), BoundsError> {
         let a = self.grad_w_j_hat.abs() - self.eps_j;
         if a <= 0.0 {
@@ -158,6 +163,7 @@ impl ExploringBound {
     /// assert!(matches!(b.safe_interval(0.1)?, StepOutcome::Infeasible { .. }));
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn safe_interval(&self, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("required", required)?;
         let (vertex, c_max) = self.vertex()?;
@@ -202,7 +208,8 @@ impl ExploringBound {
 /// |∇̂_w J| ≤ ε_J blocks a step that the budget allows.
 ///
 /// # Errors
-/// Non-finite inputs, ε_J < 0, the errors of [`d`](crate::constants::d), and [`BoundsError::Overflow`] when β
+/// Non-finite inputs, ε_J < 0, the errors of [`d`](crate::constants::d), and
+/// [`BoundsError::Overflow`] when β
 /// is not representable (|∇̂_w L| below about 1e-300).
 ///
 /// ```
@@ -256,6 +263,7 @@ impl ExploringBound {
     /// assert_eq!(b.step_along(0.4, -0.01)?, w_exploring_step(&k, 1.0, -0.3, 0.1, 0.4, -0.01)?);
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn step_along(&self, grad_w_l_hat: f64, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("grad_w_l_hat", grad_w_l_hat)?;
         finite("required", required)?;

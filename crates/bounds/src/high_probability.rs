@@ -48,6 +48,7 @@ pub struct CorrectedNorm {
 /// assert!(corrected_norm(&[0.5], 0.5)?.is_none());
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
+#[inline]
 pub fn corrected_norm(grad_hat: &[f64], eps: f64) -> Result<Option<CorrectedNorm>, BoundsError> {
     finite_vector("grad_hat", grad_hat)?;
     non_negative("eps", eps)?;
@@ -234,6 +235,7 @@ impl HighProbabilityBound {
     }
 
     /// The bound with squared corrected norms (Theorems 4.7 and 4.8) and penalty `k`.
+    #[inline]
     fn squared(n: CorrectedNorm, k: f64) -> Result<Self, BoundsError> {
         let up2 = no_overflow("(||grad||+)^2", n.upper * n.upper)?;
         Self {
@@ -248,6 +250,7 @@ impl HighProbabilityBound {
     /// Checks that the vertex and C_max are finite: with tiny task constants or estimates the
     /// quadratic coefficient b can underflow to 0 (or a⁻/(2b) overflow) although the exact
     /// values are positive, which would make [`Self::vertex`] and [`Self::c_max`] NaN or ∞.
+    #[inline]
     fn representable(self) -> Result<Self, BoundsError> {
         no_overflow("step-size vertex", self.vertex())?;
         no_overflow("C_max", self.c_max())?;
@@ -314,6 +317,7 @@ impl HighProbabilityBound {
     /// let b = HighProbabilityBound { direction: -1.0, linear_lower: 1.0, linear_upper: 4.0, quadratic: 2.0 };
     /// assert_eq!(b.vertex(), -0.25);
     /// ```
+    #[inline]
     pub fn vertex(&self) -> f64 {
         self.direction * self.linear_lower / (2.0 * self.quadratic)
     }
@@ -331,6 +335,7 @@ impl HighProbabilityBound {
     /// let b = HighProbabilityBound { direction: 1.0, linear_lower: 1.0, linear_upper: 4.0, quadratic: 2.0 };
     /// assert_eq!(b.c_max(), 0.125);
     /// ```
+    #[inline]
     pub fn c_max(&self) -> f64 {
         self.linear_lower * (self.linear_lower / (2.0 * self.quadratic)) / 2.0
     }
@@ -355,6 +360,7 @@ impl HighProbabilityBound {
     /// assert!(s.lo > t.lo); // fewer negative steps are safe
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn safe_step(&self, required: f64, form: HpForm) -> Result<StepOutcome, BoundsError> {
         finite("required", required)?;
         match form {
@@ -432,17 +438,15 @@ pub fn v_safe_step(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    v_safe_step_at(
-        &Penalties::thesis(k, sigma)?,
-        grad_v_hat,
-        eps,
+    safe_step_or_below_noise(
+        HighProbabilityBound::v_update(k, sigma, grad_v_hat, eps)?,
         required,
         form,
     )
 }
 
-/// [`v_safe_step`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
-/// the same errors, without validating σ again.
+/// [`v_safe_step`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
 pub fn v_safe_step_at(
     p: &Penalties,
     grad_v_hat: &[f64],
@@ -482,17 +486,15 @@ pub fn w_safe_step_along_j(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    w_safe_step_along_j_at(
-        &Penalties::thesis(k, sigma)?,
-        grad_w_j_hat,
-        eps,
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_j(k, sigma, grad_w_j_hat, eps)?,
         required,
         form,
     )
 }
 
-/// [`w_safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
-/// the same errors, without validating σ again.
+/// [`w_safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
 pub fn w_safe_step_along_j_at(
     p: &Penalties,
     grad_w_j_hat: f64,
@@ -537,19 +539,15 @@ pub fn w_safe_step_along_l(
     form: HpForm,
 ) -> Result<StepOutcome, BoundsError> {
     finite("required", required)?;
-    w_safe_step_along_l_at(
-        &Penalties::thesis(k, sigma)?,
-        grad_w_j_hat,
-        eps_j,
-        grad_w_l_hat,
-        eps_l,
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_l(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
         required,
         form,
     )
 }
 
-/// [`w_safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with the penalty of their family;
-/// the same errors, without validating σ again.
+/// [`w_safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
 pub fn w_safe_step_along_l_at(
     p: &Penalties,
     grad_w_j_hat: f64,

@@ -3,7 +3,8 @@
 //! Every step-size bound of Chapter 4 is a parabola whose curvature is c(σ) (the v-update,
 //! Theorems 3.14 and 4.2) or d(σ) (the w-update, Theorem 4.3) times a squared gradient. A
 //! [`Penalties`] validates σ once and computes each coefficient at most once, so that the
-//! functions taking it ([`crate::v_update::safe_step_at`], [`crate::w_update::safe_step_along_j_at`],
+//! functions taking it (the `_at` functions: [`crate::v_update::safe_step_at`],
+//! [`crate::w_update::safe_step_along_j_at`],
 //! [`crate::high_probability::HighProbabilityBound::v_update_at`], ...) neither re-validate σ
 //! nor recompute c or d.
 //!

@@ -150,7 +150,7 @@ pub fn safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    safe_step_at(&Penalties::thesis(k, sigma)?, grad_v, required)
+    parabola(Penalties::thesis(k, sigma)?.c()?, inf_norm(grad_v))?.solve(required)
 }
 
 /// [`safe_step`] for penalties evaluated once ([`Penalties`]): the safe steps of eq. (4.10)

@@ -126,7 +126,7 @@ pub fn safe_step_along_j(
 ) -> Result<StepOutcome, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
-    safe_step_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j, required)
+    parabola_along_j(Penalties::thesis(k, sigma)?.d()?, grad_w_j)?.solve(required)
 }
 
 /// [`safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
@@ -299,7 +299,8 @@ pub fn safe_step_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
-    safe_step_along_l_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l, required)
+    let d = Penalties::thesis(k, sigma)?.d()?;
+    parabola_along_l(d, grad_w_j, grad_w_l)?.solve(required)
 }
 
 /// [`safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.

@@ -106,14 +106,16 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
 /// A bound B(x) on the guaranteed improvement of a step x that can be enclosed in interval
 /// arithmetic, with x taken as an exact real.
 ///
-/// Implement it for a new step form and pass the form's `f64` [`StepOutcome`](sepg_bounds::StepOutcome) to
+/// Implement it for a new step form and pass the form's `f64`
+/// [`StepOutcome`](sepg_bounds::StepOutcome) to
 /// [`certify`](crate::certify).
 pub trait EnclosedBound {
     /// An interval that contains the exact value B(x).
     fn enclose(&self, x: f64) -> Interval;
 
     /// An approximation of B'(x), used only to guess how far a failing step must move
-    /// (any value, or `None`, keeps [`certify`](crate::certify) correct; a good one makes it faster).
+    /// (any value, or `None`, keeps [`certify`](crate::certify) correct; a good one makes it
+    /// faster).
     fn slope(&self, _x: f64) -> Option<f64> {
         None
     }

@@ -13,9 +13,9 @@
 //! [`Certified::Uncertifiable`]. docs/THEOREMS.md ("Certified steps") states what the
 //! certificate means and what it assumes.
 //!
-//! Each bound form is an [`EnclosedBound`]; [`certify()`] turns the `f64` [`StepOutcome`](sepg_bounds::StepOutcome) of
-//! any form into a [`Certified`] outcome, so a new step form is certified by implementing the
-//! trait for its bound.
+//! Each bound form is an [`EnclosedBound`]; [`certify()`] turns the `f64`
+//! [`StepOutcome`](sepg_bounds::StepOutcome) of any form into a [`Certified`] outcome, so a new
+//! step form is certified by implementing the trait for its bound.
 //!
 //! The step functions below first try a cheaper certificate: the bound evaluated in plain
 //! `f64` with an a-priori bound on its rounding error (standard model of floating-point
@@ -23,14 +23,19 @@
 //! and fall back to interval arithmetic when that analysis does not apply or does not certify
 //! a step ([`CertifiedStep::by_error_bound`] says which). The rigorous forms and
 //! [`adaptive_step`] use interval arithmetic only. On the fast path the `f64` safe interval
-//! comes from the error-free companions of the solvers ([`Parabola::feasible`](sepg_bounds::Parabola::feasible) and
-//! [`HighProbabilityBound::feasible_step`](sepg_bounds::high_probability::HighProbabilityBound::feasible_step)), which return it bit for bit or nothing, so that it
+//! comes from the error-free companions of the solvers ([`Parabola::feasible`] and
+//! [`HighProbabilityBound::feasible_step`]), which return it bit for bit or nothing, so that it
 //! stays in registers; every other outcome takes the full path.
+//!
+//! [`Parabola::feasible`]: sepg_bounds::Parabola::feasible
+//! [`HighProbabilityBound::feasible_step`]: sepg_bounds::high_probability::HighProbabilityBound::feasible_step
 //!
 //! The crate depends on `sepg-bounds` and never the reverse: the plain `f64` formulas know
 //! nothing of this layer. Whether the a-priori analysis applies to a task (its constants lie
 //! in the range where no intermediate result of c(σ) or d(σ) underflows or overflows) is
-//! decided here, from the [`TaskConstants`](sepg_bounds::TaskConstants) alone.
+//! decided here: once, by a [`CertifiedTask`] built from the
+//! [`TaskConstants`](sepg_bounds::TaskConstants), or at each call when a step function is
+//! given the task constants themselves.
 //!
 //! | module | contents |
 //! |---|---|
@@ -38,6 +43,7 @@
 //! | [`enclosure`] | enclosures of √(2π), ψ, c(σ), d(σ) and of every bound form ([`EnclosedBound`]) |
 //! | [`certificate`] | the certificate of an `f64` outcome ([`certify()`], [`Certified`]) |
 //! | [`steps`] | the certified step of each bound form (table below) |
+//! | [`task`] | [`CertifiedTask`]: the task constants with their rounding range decided once |
 //!
 //! | function | bound | thesis |
 //! |---|---|---|
@@ -68,6 +74,7 @@ pub mod enclosure;
 pub mod interval;
 mod rounding;
 pub mod steps;
+pub mod task;
 
 pub use certificate::{Certified, CertifiedStep, certify, certify_toward};
 pub use enclosure::{
@@ -80,3 +87,4 @@ pub use steps::{
     hp_w_safe_step_along_l, rigorous_safe_step_along_j, rigorous_safe_step_along_l, v_safe_step,
     w_safe_step_along_j, w_safe_step_along_l,
 };
+pub use task::{AsCertifiedTask, CertifiedTask};

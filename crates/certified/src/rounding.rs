@@ -28,8 +28,9 @@
 //!
 //!   Both counts need every intermediate result to be a normal number: that holds when R,
 //!   M_φ, |A| and σ lie in [2⁻¹⁰⁰, 2¹⁰⁰] and γ = 0 or γ ≥ 2⁻¹⁰⁰ (every intermediate then lies
-//!   within 2^±810), which [`apriori_box`] checks ([`task_in_box`] for the part on R, M_φ,
-//!   |A|, γ, a handful of comparisons); outside it the interval path is used.
+//!   within 2^±810), which [`apriori_box`] checks (the part on R, M_φ, |A|, γ once, when the
+//!   [`CertifiedTask`](crate::CertifiedTask) is built, or at each call: [`task_in_box`]); outside
+//!   it the interval path is used.
 //! - Further products are checked one at a time: a product whose result is normal obeys the
 //!   model ([`Rounded::mul`] returns `None` otherwise).
 //! - **The parabola at an exact x** ([`RoundedBound::enclose`]). With â = a(1 + θ_a),
@@ -75,10 +76,11 @@ const BOX_LO: f64 = 7.888_609_052_210_118e-31;
 const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
 
 /// Whether R, M_φ, |A| ∈ [2⁻¹⁰⁰, 2¹⁰⁰], γ = 0 or γ ≥ 2⁻¹⁰⁰, and the platform's ψ lies within
-/// one ulp of its enclosure (the last condition only matters for d, and holds wherever `exp`
-/// is accurate to an ulp; it is decided once per process).
+/// one ulp of its enclosure (the last condition only matters for d, holds wherever `exp` is
+/// accurate to an ulp, and is decided once per process): the range of the task constants that
+/// [`CertifiedTask`](crate::CertifiedTask) decides once.
 #[inline]
-fn task_in_box(k: &TaskConstants) -> bool {
+pub(crate) fn task_in_box(k: &TaskConstants) -> bool {
     let inside = |x: f64| (BOX_LO..=BOX_HI).contains(&x);
     let gamma = k.gamma();
     inside(k.r_max())
@@ -90,10 +92,11 @@ fn task_in_box(k: &TaskConstants) -> bool {
 
 /// Whether the roundings counted for c(σ) and d(σ) hold: R, M_φ, |A|, σ ∈ [2⁻¹⁰⁰, 2¹⁰⁰] and
 /// γ = 0 or γ ≥ 2⁻¹⁰⁰, so that no intermediate result underflows or overflows, and the
-/// platform's ψ is enclosed ([`task_in_box`]).
+/// platform's ψ is enclosed (`in_range`: [`task_in_box`] of the task constants, decided once
+/// by a [`CertifiedTask`](crate::CertifiedTask) or at the call).
 #[inline]
-fn apriori_box(k: &TaskConstants, sigma: f64) -> bool {
-    task_in_box(k) && (BOX_LO..=BOX_HI).contains(&sigma)
+fn apriori_box(in_range: bool, sigma: f64) -> bool {
+    in_range && (BOX_LO..=BOX_HI).contains(&sigma)
 }
 
 /// Whether the platform's `f64` ψ ([`constants::psi`], which calls `exp`) lies within one ulp
@@ -166,8 +169,8 @@ impl Rounded {
 /// c(σ) with its 14 roundings, from `value` = [`constants::c`]`(k, sigma)`; `None` outside
 /// [`apriori_box`].
 #[inline]
-pub(crate) fn c(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
-    apriori_box(k, sigma).then_some(Rounded {
+pub(crate) fn c(in_range: bool, sigma: f64, value: f64) -> Option<Rounded> {
+    apriori_box(in_range, sigma).then_some(Rounded {
         value,
         roundings: C_ROUNDINGS,
     })
@@ -177,8 +180,8 @@ pub(crate) fn c(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
 /// [`apriori_box`] (which includes the check that the platform's ψ is within one ulp of its
 /// enclosure).
 #[inline]
-pub(crate) fn d(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
-    apriori_box(k, sigma).then_some(Rounded {
+pub(crate) fn d(in_range: bool, sigma: f64, value: f64) -> Option<Rounded> {
+    apriori_box(in_range, sigma).then_some(Rounded {
         value,
         roundings: D_ROUNDINGS,
     })

@@ -1,7 +1,7 @@
 //! The certified step of each bound form: the `f64` step of `sepg-bounds`, certified by the
 //! a-priori error bound when it applies and by interval arithmetic otherwise (crate docs).
 
-use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::TaskConstants;
 use sepg_bounds::error::{BoundsError, finite, finite_vector, inf_norm};
 use sepg_bounds::exploring::ExploringBound;
 use sepg_bounds::high_probability::{self as hp, HpForm};
@@ -15,6 +15,7 @@ use crate::enclosure::{
 };
 use crate::interval::Interval;
 use crate::rounding::{self, Rounded, RoundedBound};
+use crate::task::AsCertifiedTask;
 
 /// The common tail of the certified high-probability steps: the fast path on the
 /// feasible interval of `bound`, else the full path on its outcome
@@ -40,6 +41,7 @@ fn certify_high_probability<S: EnclosedBound>(
 }
 
 /// The parabola a·x − b·x² with a = g², b = k·g² (Theorems 4.2, 4.3) in rounded `f64`.
+#[inline(always)]
 fn squared_parabola(g: f64, k: Option<Rounded>) -> Option<RoundedBound> {
     let g = Rounded::exact(g);
     let a = g.mul(g)?;
@@ -48,6 +50,7 @@ fn squared_parabola(g: f64, k: Option<Rounded>) -> Option<RoundedBound> {
 
 /// The high-probability bound with s = +1, a^∓ = (n ∓ ε)², b = k·a⁺ (Theorems 4.7, 4.8) in
 /// rounded `f64`; only called when n > ε.
+#[inline(always)]
 fn corrected_parabola(n: f64, eps: f64, k: Option<Rounded>, form: HpForm) -> Option<RoundedBound> {
     let (lower, upper) = (Rounded::difference(n, eps), Rounded::sum(n, eps));
     let upper2 = upper.mul(upper)?;
@@ -80,7 +83,25 @@ fn corrected_parabola(n: f64, eps: f64, k: Option<Rounded>, form: HpForm) -> Opt
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn v_safe_step(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_v: &[f64],
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    v_safe_step_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_v,
+        required,
+    )
+}
+
+/// [`v_safe_step`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn v_safe_step_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_v: &[f64],
     required: f64,
@@ -89,7 +110,7 @@ pub fn v_safe_step(
     finite("required", required)?;
     let cc = Penalties::thesis(k, sigma)?.c()?;
     let n = inf_norm(grad_v);
-    let fast = move || squared_parabola(n, rounding::c(k, sigma, cc));
+    let fast = move || squared_parabola(n, rounding::c(in_range, sigma, cc));
     let parabola = v_update::parabola(cc, n);
     certify_step(
         parabola.ok().and_then(|p| p.feasible(required)),
@@ -110,7 +131,25 @@ pub fn v_safe_step(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn w_safe_step_along_j(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    w_safe_step_along_j_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j,
+        required,
+    )
+}
+
+/// [`w_safe_step_along_j`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn w_safe_step_along_j_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_w_j: f64,
     required: f64,
@@ -118,7 +157,7 @@ pub fn w_safe_step_along_j(
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
     let dd = Penalties::thesis(k, sigma)?.d()?;
-    let fast = move || squared_parabola(grad_w_j, rounding::d(k, sigma, dd));
+    let fast = move || squared_parabola(grad_w_j, rounding::d(in_range, sigma, dd));
     let parabola = w_update::parabola_along_j(dd, grad_w_j);
     certify_step(
         parabola.ok().and_then(|p| p.feasible(required)),
@@ -140,7 +179,27 @@ pub fn w_safe_step_along_j(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn w_safe_step_along_l(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    w_safe_step_along_l_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j,
+        grad_w_l,
+        required,
+    )
+}
+
+/// [`w_safe_step_along_l`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn w_safe_step_along_l_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_w_j: f64,
     grad_w_l: f64,
@@ -152,7 +211,7 @@ pub fn w_safe_step_along_l(
     let dd = Penalties::thesis(k, sigma)?.d()?;
     let fast = move || {
         let (j, l) = (Rounded::exact(grad_w_j), Rounded::exact(grad_w_l));
-        let b = rounding::d(k, sigma, dd)?.mul(l.mul(l)?)?;
+        let b = rounding::d(in_range, sigma, dd)?.mul(l.mul(l)?)?;
         Some(RoundedBound::parabola(l.mul(j)?, b))
     };
     let parabola = w_update::parabola_along_l(dd, grad_w_j, grad_w_l);
@@ -175,7 +234,29 @@ pub fn w_safe_step_along_l(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn hp_v_safe_step(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_v_hat: &[f64],
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    hp_v_safe_step_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_v_hat,
+        eps,
+        required,
+        form,
+    )
+}
+
+/// [`hp_v_safe_step`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn hp_v_safe_step_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_v_hat: &[f64],
     eps: f64,
@@ -186,8 +267,14 @@ pub fn hp_v_safe_step(
     let penalties = Penalties::thesis(k, sigma)?;
     let cc = penalties.c()?;
     let bound = hp::HighProbabilityBound::v_update_at(&penalties, grad_v_hat, eps)?;
-    let fast =
-        move || corrected_parabola(inf_norm(grad_v_hat), eps, rounding::c(k, sigma, cc), form);
+    let fast = move || {
+        corrected_parabola(
+            inf_norm(grad_v_hat),
+            eps,
+            rounding::c(in_range, sigma, cc),
+            form,
+        )
+    };
     certify_high_probability(bound, required, form, fast, move || {
         HpEnclosure::v_update(k, sigma, grad_v_hat, eps, form)
     })
@@ -204,7 +291,29 @@ pub fn hp_v_safe_step(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn hp_w_safe_step_along_j(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j_hat: f64,
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    hp_w_safe_step_along_j_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j_hat,
+        eps,
+        required,
+        form,
+    )
+}
+
+/// [`hp_w_safe_step_along_j`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn hp_w_safe_step_along_j_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_w_j_hat: f64,
     eps: f64,
@@ -215,7 +324,14 @@ pub fn hp_w_safe_step_along_j(
     let penalties = Penalties::thesis(k, sigma)?;
     let dd = penalties.d()?;
     let bound = hp::HighProbabilityBound::w_along_j_at(&penalties, grad_w_j_hat, eps)?;
-    let fast = move || corrected_parabola(grad_w_j_hat.abs(), eps, rounding::d(k, sigma, dd), form);
+    let fast = move || {
+        corrected_parabola(
+            grad_w_j_hat.abs(),
+            eps,
+            rounding::d(in_range, sigma, dd),
+            form,
+        )
+    };
     certify_high_probability(bound, required, form, fast, move || {
         HpEnclosure::w_along_j(k, sigma, grad_w_j_hat, eps, form)
     })
@@ -233,7 +349,29 @@ pub fn hp_w_safe_step_along_j(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn hp_w_safe_step_along_l(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j_hat: (f64, f64),
+    grad_w_l_hat: (f64, f64),
+    required: f64,
+    form: HpForm,
+) -> Result<Certified, BoundsError> {
+    hp_w_safe_step_along_l_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j_hat,
+        grad_w_l_hat,
+        required,
+        form,
+    )
+}
+
+/// [`hp_w_safe_step_along_l`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn hp_w_safe_step_along_l_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_w_j_hat: (f64, f64),
     grad_w_l_hat: (f64, f64),
@@ -250,7 +388,7 @@ pub fn hp_w_safe_step_along_l(
         let (nj, nl) = (j.abs(), l.abs());
         let (l_hi, j_hi) = (Rounded::sum(nl, el), Rounded::sum(nj, ej));
         let lower = Rounded::difference(nl, el).mul(Rounded::difference(nj, ej))?;
-        let b = rounding::d(k, sigma, dd)?.mul(l_hi.mul(l_hi)?)?;
+        let b = rounding::d(in_range, sigma, dd)?.mul(l_hi.mul(l_hi)?)?;
         let direction = if (j > 0.0) == (l > 0.0) { 1.0 } else { -1.0 };
         Some(RoundedBound::high_probability(
             direction,
@@ -276,7 +414,25 @@ pub fn hp_w_safe_step_along_l(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn rigorous_safe_step_along_j(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    rigorous_safe_step_along_j_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j,
+        required,
+    )
+}
+
+/// [`rigorous_safe_step_along_j`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn rigorous_safe_step_along_j_in(
     k: &TaskConstants,
+    _in_range: bool,
     sigma: f64,
     grad_w_j: f64,
     required: f64,
@@ -302,7 +458,27 @@ pub fn rigorous_safe_step_along_j(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn rigorous_safe_step_along_l(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    rigorous_safe_step_along_l_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j,
+        grad_w_l,
+        required,
+    )
+}
+
+/// [`rigorous_safe_step_along_l`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn rigorous_safe_step_along_l_in(
     k: &TaskConstants,
+    _in_range: bool,
     sigma: f64,
     grad_w_j: f64,
     grad_w_l: f64,
@@ -330,7 +506,29 @@ pub fn rigorous_safe_step_along_l(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn exploring_safe_step(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    required: f64,
+) -> Result<Certified, BoundsError> {
+    exploring_safe_step_in(
+        task.constants(),
+        task.in_rounding_range(),
+        sigma,
+        grad_w_j_hat,
+        eps_j,
+        grad_w_l_hat,
+        required,
+    )
+}
+
+/// [`exploring_safe_step`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn exploring_safe_step_in(
     k: &TaskConstants,
+    in_range: bool,
     sigma: f64,
     grad_w_j_hat: f64,
     eps_j: f64,
@@ -352,7 +550,7 @@ pub fn exploring_safe_step(
         } else {
             (against, toward)
         };
-        let b = rounding::d(k, sigma, bound.d)?.mul(l.mul(l)?)?;
+        let b = rounding::d(in_range, sigma, bound.d)?.mul(l.mul(l)?)?;
         Some(RoundedBound::two_sided(l.mul(pos)?, l.mul(neg)?, b))
     };
     certify_fast_then_interval(outcome, required, fast, move || {
@@ -387,7 +585,18 @@ pub fn exploring_safe_step(
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn adaptive_step(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    grad: &[f64],
+) -> Result<Certified, BoundsError> {
+    adaptive_step_in(task.constants(), task.in_rounding_range(), sigma, grad)
+}
+
+/// [`adaptive_step`] for the task constants `k` whose rounding range is `in_range`, compiled
+/// once in this crate (the generic function above only chooses how the range is decided).
+fn adaptive_step_in(
     k: &TaskConstants,
+    _in_range: bool,
     sigma: f64,
     grad: &[f64],
 ) -> Result<Certified, BoundsError> {

@@ -1,5 +1,7 @@
-//! Every quantity of `sepg_bounds`, one Python function per Rust function, named
-//! `<module>_<function>` after the Rust path (`v_update::safe_step` → `v_update_safe_step`),
+//! Every quantity of `sepg_bounds` and the certified steps of `sepg_certified`, one Python
+//! function per Rust function, named `<module>_<function>` after the Rust path
+//! (`v_update::safe_step` → `v_update_safe_step`, `sepg_certified::v_safe_step` →
+//! `certified_v_safe_step`),
 //! and its classes: `StepOutcome`, `HighProbabilityBound`, `Budget`, `ExploringBound`, and
 //! the interval arithmetic of the certified steps (`Interval`, `Enclosure`, `Certified`).
 //! Vectors are any one-dimensional array-like of floats; steps and improvements are in the

@@ -3,18 +3,23 @@
 //! interval arithmetic otherwise; both certify the step.
 
 use sepg_bounds::TaskConstants;
-use sepg_certified::{Certified, CertifiedStep, v_safe_step, w_safe_step_along_j};
+use sepg_certified::{Certified, CertifiedStep, CertifiedTask, v_safe_step, w_safe_step_along_j};
 
 /// The certified v-step (Theorem 4.2) of the `lqg1d` inputs of the bench, with one constant
-/// replaced.
+/// replaced; the range decided once by a `CertifiedTask` gives the same outcome as the range
+/// decided at the call, and agrees with the path taken.
 fn v_step(gamma: f64, r: f64, m: f64, a: f64) -> CertifiedStep {
     let k = TaskConstants::new(gamma, r, m, a).expect("valid constants");
     // scale the gradient so that ‖∇‖²·c stays of order one whatever the constants
     let c = sepg_bounds::constants::c(&k, 0.5).expect("finite");
     let grad = [-3.7 * c.sqrt()];
-    match v_safe_step(&k, 0.5, &grad, 0.0).expect("valid") {
+    let task = CertifiedTask::new(&k);
+    let once = v_safe_step(&task, 0.5, &grad, 0.0).expect("valid");
+    assert_eq!(once, v_safe_step(&k, 0.5, &grad, 0.0).expect("valid"));
+    match once {
         Certified::Step(s) => {
             assert!(s.bound.lo() >= 0.0);
+            assert_eq!(s.by_error_bound, task.in_rounding_range());
             s
         }
         other => panic!("expected a certified step, got {other:?}"),
