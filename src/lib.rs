@@ -4,7 +4,9 @@
 //! whole toolkit:
 //!
 //! - [`bounds`]: every closed-form quantity of the thesis (ψ, c, d, α*, β̃, λ, C_max, batch
-//!   sizes, high-probability and rigorous variants, the budget of Theorem 4.1);
+//!   sizes, high-probability and rigorous variants, the budget of Theorem 4.1), in `f64`;
+//! - [`certified`]: the safe steps of [`bounds`] whose guarantee survives floating-point
+//!   rounding (interval arithmetic and a-priori rounding-error bounds);
 //! - [`mdp`]: environments (LQG presets, n-D LQG, Mountain Car), the factored Gaussian linear
 //!   policy, the deterministic parallel rollout engine and the exact LQG oracles;
 //! - [`estimators`]: REINFORCE, G(PO)MDP, baselines, ∇_w L and confidence widths;
@@ -17,6 +19,7 @@
 
 pub use sepg_algo as algo;
 pub use sepg_bounds as bounds;
+pub use sepg_certified as certified;
 pub use sepg_estimators as estimators;
 pub use sepg_mdp as mdp;
 pub use sepg_runs as runs;

@@ -7,22 +7,25 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
 use sepg_algo::core::executor::Solver;
 use sepg_algo::solver::PolicySolver;
-use sepg_bounds::certified;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HpForm};
 use sepg_bounds::{exploring, v_update, w_update};
+use sepg_certified as certified;
 use sepg_mdp::env::Preset;
 use std::hint::black_box;
 
 fn steps(c: &mut Criterion) {
     let k = TaskConstants::new(0.99, 28.8, 4.0, 8.0).expect("lqg1d constants");
+    // the certified steps decide the range of the rounding analysis once, as the uncertified
+    // ones validate the constants once
+    let task = certified::CertifiedTask::new(&k);
     let (sigma, grad, required) = (0.5, [-3.7], 0.0);
     let mut g = c.benchmark_group("v_step");
     g.bench_function("uncertified", |b| {
         b.iter(|| v_update::safe_step(&k, black_box(sigma), black_box(&grad), required))
     });
     g.bench_function("certified", |b| {
-        b.iter(|| certified::v_safe_step(&k, black_box(sigma), black_box(&grad), required))
+        b.iter(|| certified::v_safe_step(&task, black_box(sigma), black_box(&grad), required))
     });
     g.finish();
     let mut g = c.benchmark_group("w_step_along_l");
@@ -30,7 +33,9 @@ fn steps(c: &mut Criterion) {
         b.iter(|| w_update::safe_step_along_l(&k, black_box(sigma), 0.3, black_box(-2.0), -0.1))
     });
     g.bench_function("certified", |b| {
-        b.iter(|| certified::w_safe_step_along_l(&k, black_box(sigma), 0.3, black_box(-2.0), -0.1))
+        b.iter(|| {
+            certified::w_safe_step_along_l(&task, black_box(sigma), 0.3, black_box(-2.0), -0.1)
+        })
     });
     g.finish();
     let mut g = c.benchmark_group("hp_v_step");
@@ -49,7 +54,7 @@ fn steps(c: &mut Criterion) {
     g.bench_function("certified", |b| {
         b.iter(|| {
             certified::hp_v_safe_step(
-                &k,
+                &task,
                 black_box(sigma),
                 black_box(&grad),
                 0.4,
@@ -67,7 +72,14 @@ fn steps(c: &mut Criterion) {
     });
     g.bench_function("certified", |b| {
         b.iter(|| {
-            certified::exploring_safe_step(&k, black_box(sigma), -0.3, 0.1, black_box(0.4), -0.01)
+            certified::exploring_safe_step(
+                &task,
+                black_box(sigma),
+                -0.3,
+                0.1,
+                black_box(0.4),
+                -0.01,
+            )
         })
     });
     g.finish();

@@ -4,11 +4,11 @@
 use std::collections::BTreeMap;
 
 use clap::Args;
-use sepg_bounds::certified::{self, Certified, Quadratic};
 use sepg_bounds::constants::{self, TaskConstants};
-use sepg_bounds::interval::Interval;
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
+use sepg_certified::Interval;
+use sepg_certified::{self as certified, Certified, Quadratic};
 use serde::Serialize;
 
 use crate::cli::CliError;

@@ -21,9 +21,6 @@ pub struct TaskConstants {
     m_phi: f64,
     action_volume: f64,
     psi: Option<f64>,
-    /// Whether R, M_φ, |A| and γ lie in the range of the rounding analysis of c and d
-    /// (`crate::rounding`), decided once here.
-    rounding_box: bool,
 }
 
 impl TaskConstants {
@@ -63,7 +60,6 @@ impl TaskConstants {
             m_phi,
             action_volume,
             psi: None,
-            rounding_box: crate::rounding::task_in_box(gamma, r_max, m_phi, action_volume),
         })
     }
 
@@ -91,12 +87,6 @@ impl TaskConstants {
     /// The ψ that replaces Lemma A.1's value, if any ([`TaskConstants::with_psi`]).
     pub fn psi_override(&self) -> Option<f64> {
         self.psi
-    }
-
-    /// Whether R, M_φ, |A| and γ lie in the range of the rounding analysis (`crate::rounding`).
-    #[inline]
-    pub(crate) fn in_rounding_box(&self) -> bool {
-        self.rounding_box
     }
 
     /// The ψ that d (Theorem 4.3) uses: the override, or Lemma A.1's [`psi()`].
@@ -201,14 +191,21 @@ pub fn psi() -> f64 {
 /// assert!((c(&k, 1.0)? - expected).abs() < 1e-14);
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
+#[inline]
 pub fn c(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     positive("sigma", sigma)?;
+    no_overflow("c", c_value(k, sigma))
+}
+
+/// c(σ) of [`c`] for a validated σ, unchecked for overflow.
+#[inline]
+pub(crate) fn c_value(k: &TaskConstants, sigma: f64) -> f64 {
     let g = k.gamma;
     let one_minus = 1.0 - g;
     let front = k.r_max * k.m_phi * k.m_phi / (one_minus * one_minus);
     let bracket_over_sigma2 = k.action_volume / (SQRT_2PI * sigma * sigma * sigma)
         + g / (2.0 * one_minus * sigma * sigma);
-    no_overflow("c", front * bracket_over_sigma2)
+    front * bracket_over_sigma2
 }
 
 /// The analytic derivative ∂c/∂σ of [`c`] (used by the surrogate gradient of Appendix B).
@@ -261,12 +258,19 @@ fn psi_of(k: &TaskConstants) -> f64 {
 /// assert!((d(&k, 1.0)? - psi()).abs() < 1e-15);
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
+#[inline]
 pub fn d(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     positive("sigma", sigma)?;
+    no_overflow("d", d_value(k, sigma))
+}
+
+/// d(σ) of [`d`] for a validated σ, unchecked for overflow.
+#[inline]
+pub(crate) fn d_value(k: &TaskConstants, sigma: f64) -> f64 {
     let one_minus = 1.0 - k.gamma;
     let front = k.r_max / (one_minus * one_minus);
     let bracket = psi_of(k) * k.action_volume / (2.0 * sigma) + k.gamma / one_minus;
-    no_overflow("d", front * bracket)
+    front * bracket
 }
 
 /// The two coefficients of the rigorous w-bound (module [`crate::rigorous`]):

@@ -61,8 +61,11 @@ pub enum BoundsError {
     NoTargetPolicy,
 }
 
-/// Returns `value` if it is finite, otherwise [`BoundsError::NonFinite`].
-pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, BoundsError> {
+/// Returns `value` if it is finite, otherwise [`BoundsError::NonFinite`] naming the input
+/// `name`. The validation every function of the crate (and of the crates built on it) applies
+/// to its `f64` inputs.
+#[inline]
+pub fn finite(name: &'static str, value: f64) -> Result<f64, BoundsError> {
     if value.is_finite() {
         Ok(value)
     } else {
@@ -70,8 +73,10 @@ pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, BoundsError>
     }
 }
 
-/// Returns `value` if it is finite and strictly positive.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, BoundsError> {
+/// Returns `value` if it is finite and strictly positive, otherwise
+/// [`BoundsError::NonFinite`] or [`BoundsError::OutOfDomain`] (domain (0, +∞)).
+#[inline]
+pub fn positive(name: &'static str, value: f64) -> Result<f64, BoundsError> {
     finite(name, value)?;
     if value > 0.0 {
         Ok(value)
@@ -84,8 +89,10 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, BoundsErro
     }
 }
 
-/// Returns `value` if it is finite and non-negative.
-pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64, BoundsError> {
+/// Returns `value` if it is finite and non-negative, otherwise [`BoundsError::NonFinite`]
+/// or [`BoundsError::OutOfDomain`] (domain [0, +∞)).
+#[inline]
+pub fn non_negative(name: &'static str, value: f64) -> Result<f64, BoundsError> {
     finite(name, value)?;
     if value >= 0.0 {
         Ok(value)
@@ -126,8 +133,10 @@ pub(crate) fn unit_open(name: &'static str, value: f64) -> Result<f64, BoundsErr
     }
 }
 
-/// Checks that a vector is non-empty and all its entries are finite.
-pub(crate) fn finite_vector(name: &'static str, values: &[f64]) -> Result<(), BoundsError> {
+/// Checks that a vector is non-empty ([`BoundsError::EmptyVector`]) and all its entries are
+/// finite ([`BoundsError::NonFinite`]).
+#[inline]
+pub fn finite_vector(name: &'static str, values: &[f64]) -> Result<(), BoundsError> {
     if values.is_empty() {
         return Err(BoundsError::EmptyVector { name });
     }
@@ -157,7 +166,8 @@ pub(crate) fn same_length(
 }
 
 /// Returns `value` if it is finite, otherwise [`BoundsError::Overflow`] naming `quantity`.
-pub(crate) fn no_overflow(quantity: &'static str, value: f64) -> Result<f64, BoundsError> {
+#[inline]
+pub fn no_overflow(quantity: &'static str, value: f64) -> Result<f64, BoundsError> {
     if value.is_finite() {
         Ok(value)
     } else {
@@ -166,6 +176,7 @@ pub(crate) fn no_overflow(quantity: &'static str, value: f64) -> Result<f64, Bou
 }
 
 /// ‖x‖∞ of a validated vector (overflow-free: a maximum of finite magnitudes).
-pub(crate) fn inf_norm(values: &[f64]) -> f64 {
+#[inline]
+pub fn inf_norm(values: &[f64]) -> f64 {
     values.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
 }

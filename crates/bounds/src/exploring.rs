@@ -29,9 +29,11 @@
 //! third-order term for Δw < 0 (ERRATA §10); on the LQG presets at γ = 0.99 it is
 //! conservative for σ ≥ 0.1.
 
-use crate::constants::{TaskConstants, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, no_overflow, non_negative};
-use crate::outcome::{SafeInterval, StepOutcome, solve_quadratic};
+use crate::outcome::{SafeInterval, StepOutcome};
+use crate::parabola::Parabola;
+use crate::penalties::Penalties;
 
 /// The lower bound B(Δw) of the exploring w-update for an estimate ∇̂_w J with half-width ε_J.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,7 +50,7 @@ impl ExploringBound {
     /// The bound for the task `k` at standard deviation `sigma`.
     ///
     /// # Errors
-    /// Non-finite ∇̂_w J, ε_J < 0 or non-finite, and the errors of [`d`].
+    /// Non-finite ∇̂_w J, ε_J < 0 or non-finite, and the errors of [`d`](crate::constants::d).
     ///
     /// ```
     /// use sepg_bounds::{constants::{TaskConstants, d}, exploring::ExploringBound};
@@ -58,6 +60,7 @@ impl ExploringBound {
     /// assert!(ExploringBound::new(&k, 0.5, f64::NAN, 0.3).is_err());
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn new(
         k: &TaskConstants,
         sigma: f64,
@@ -67,7 +70,18 @@ impl ExploringBound {
         Ok(ExploringBound {
             grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
             eps_j: non_negative("eps_j", eps_j)?,
-            d: d(k, sigma)?,
+            d: Penalties::thesis(k, sigma)?.d()?,
+        })
+    }
+
+    /// [`ExploringBound::new`] for penalties evaluated once ([`Penalties`]), with
+    /// d = `p.d()` of their family; the same errors, without validating σ again.
+    #[inline]
+    pub fn at(p: &Penalties, grad_w_j_hat: f64, eps_j: f64) -> Result<Self, BoundsError> {
+        Ok(ExploringBound {
+            grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
+            eps_j: non_negative("eps_j", eps_j)?,
+            d: p.d()?,
         })
     }
 
@@ -112,6 +126,7 @@ impl ExploringBound {
     /// assert_eq!(noisy.vertex()?, (0.0, 0.0));
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn vertex(&self) -> Result<(f64, f64), BoundsError> {
         let a = self.grad_w_j_hat.abs() - self.eps_j;
         if a <= 0.0 {
@@ -148,11 +163,12 @@ impl ExploringBound {
     /// assert!(matches!(b.safe_interval(0.1)?, StepOutcome::Infeasible { .. }));
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn safe_interval(&self, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("required", required)?;
         let (vertex, c_max) = self.vertex()?;
-        let positive = solve_quadratic(self.grad_w_j_hat - self.eps_j, self.d, required)?;
-        let negative = solve_quadratic(self.grad_w_j_hat + self.eps_j, self.d, required)?;
+        let positive = Parabola::new(self.grad_w_j_hat - self.eps_j, self.d).solve(required)?;
+        let negative = Parabola::new(self.grad_w_j_hat + self.eps_j, self.d).solve(required)?;
         let side = |o: StepOutcome, keep: fn(f64, f64) -> Option<(f64, f64)>| match o {
             StepOutcome::Feasible(s) => keep(s.lo, s.hi),
             _ => None,
@@ -192,7 +208,8 @@ impl ExploringBound {
 /// |∇̂_w J| ≤ ε_J blocks a step that the budget allows.
 ///
 /// # Errors
-/// Non-finite inputs, ε_J < 0, the errors of [`d`], and [`BoundsError::Overflow`] when β
+/// Non-finite inputs, ε_J < 0, the errors of [`d`](crate::constants::d), and
+/// [`BoundsError::Overflow`] when β
 /// is not representable (|∇̂_w L| below about 1e-300).
 ///
 /// ```
@@ -220,13 +237,34 @@ pub fn w_exploring_step(
     bound.step_along(grad_w_l_hat, required)
 }
 
+/// [`w_exploring_step`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of
+/// their family; the same errors, without validating σ again.
+pub fn w_exploring_step_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    required: f64,
+) -> Result<StepOutcome, BoundsError> {
+    ExploringBound::at(p, grad_w_j_hat, eps_j)?.step_along(grad_w_l_hat, required)
+}
+
 impl ExploringBound {
-    /// The exploring step along ∇̂_w L for this bound: the body of [`w_exploring_step`].
-    pub(crate) fn step_along(
-        &self,
-        grad_w_l_hat: f64,
-        required: f64,
-    ) -> Result<StepOutcome, BoundsError> {
+    /// The exploring step along ∇̂_w L for this bound: [`w_exploring_step`] without
+    /// evaluating d(σ) again.
+    ///
+    /// Errors: non-finite ∇̂_w L or `required`, and [`BoundsError::Overflow`] when β is not
+    /// representable.
+    ///
+    /// ```
+    /// use sepg_bounds::{constants::TaskConstants, exploring::{ExploringBound, w_exploring_step}};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let b = ExploringBound::new(&k, 1.0, -0.3, 0.1)?;
+    /// assert_eq!(b.step_along(0.4, -0.01)?, w_exploring_step(&k, 1.0, -0.3, 0.1, 0.4, -0.01)?);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    #[inline]
+    pub fn step_along(&self, grad_w_l_hat: f64, required: f64) -> Result<StepOutcome, BoundsError> {
         finite("grad_w_l_hat", grad_w_l_hat)?;
         finite("required", required)?;
         if grad_w_l_hat == 0.0 {

@@ -18,12 +18,11 @@
 //! −|x|·a⁺. For C < 0 the printed intervals (4.26), (4.29), (4.30) reach that side, so the
 //! sign-aware form is the one that keeps the guarantee there.
 
-use crate::constants::{TaskConstants, c, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow, non_negative};
-use crate::outcome::{
-    SafeInterval, StepOutcome, feasible_interval, feasible_sign_aware, solve_quadratic,
-    solve_sign_aware,
-};
+use crate::outcome::{SafeInterval, StepOutcome};
+use crate::parabola::{Parabola, feasible_sign_aware, solve_sign_aware};
+use crate::penalties::Penalties;
 
 /// Lower- and upper-corrected gradient norms of Section 4.5.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +48,7 @@ pub struct CorrectedNorm {
 /// assert!(corrected_norm(&[0.5], 0.5)?.is_none());
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
+#[inline]
 pub fn corrected_norm(grad_hat: &[f64], eps: f64) -> Result<Option<CorrectedNorm>, BoundsError> {
     finite_vector("grad_hat", grad_hat)?;
     non_negative("eps", eps)?;
@@ -113,15 +113,17 @@ impl HighProbabilityBound {
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::v_update_with_c(c(k, sigma)?, grad_v_hat, eps)
+        Self::v_update_at(&Penalties::thesis(k, sigma)?, grad_v_hat, eps)
     }
 
-    /// [`Self::v_update`] for a given c(σ).
-    pub(crate) fn v_update_with_c(
-        cc: f64,
+    /// [`Self::v_update`] for penalties evaluated once ([`Penalties`]), with c = `p.c()`.
+    #[inline]
+    pub fn v_update_at(
+        p: &Penalties,
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let cc = p.c()?;
         let Some(n) = corrected_norm(grad_v_hat, eps)? else {
             return Ok(None);
         };
@@ -149,15 +151,17 @@ impl HighProbabilityBound {
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::w_along_j_with_d(d(k, sigma)?, grad_w_j_hat, eps)
+        Self::w_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j_hat, eps)
     }
 
-    /// [`Self::w_along_j`] for a given d(σ).
-    pub(crate) fn w_along_j_with_d(
-        dd: f64,
+    /// [`Self::w_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+    #[inline]
+    pub fn w_along_j_at(
+        p: &Penalties,
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let dd = p.d()?;
         let Some(n) = corrected_norm(&[grad_w_j_hat], eps)? else {
             return Ok(None);
         };
@@ -191,17 +195,25 @@ impl HighProbabilityBound {
         grad_w_l_hat: f64,
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::w_along_l_with_d(d(k, sigma)?, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)
+        Self::w_along_l_at(
+            &Penalties::thesis(k, sigma)?,
+            grad_w_j_hat,
+            eps_j,
+            grad_w_l_hat,
+            eps_l,
+        )
     }
 
-    /// [`Self::w_along_l`] for a given d(σ).
-    pub(crate) fn w_along_l_with_d(
-        dd: f64,
+    /// [`Self::w_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+    #[inline]
+    pub fn w_along_l_at(
+        p: &Penalties,
         grad_w_j_hat: f64,
         eps_j: f64,
         grad_w_l_hat: f64,
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
+        let dd = p.d()?;
         let nj = corrected_norm(&[grad_w_j_hat], eps_j)?;
         let nl = corrected_norm(&[grad_w_l_hat], eps_l)?;
         let (Some(nj), Some(nl)) = (nj, nl) else {
@@ -223,6 +235,7 @@ impl HighProbabilityBound {
     }
 
     /// The bound with squared corrected norms (Theorems 4.7 and 4.8) and penalty `k`.
+    #[inline]
     fn squared(n: CorrectedNorm, k: f64) -> Result<Self, BoundsError> {
         let up2 = no_overflow("(||grad||+)^2", n.upper * n.upper)?;
         Self {
@@ -237,6 +250,7 @@ impl HighProbabilityBound {
     /// Checks that the vertex and C_max are finite: with tiny task constants or estimates the
     /// quadratic coefficient b can underflow to 0 (or a⁻/(2b) overflow) although the exact
     /// values are positive, which would make [`Self::vertex`] and [`Self::c_max`] NaN or ∞.
+    #[inline]
     fn representable(self) -> Result<Self, BoundsError> {
         no_overflow("step-size vertex", self.vertex())?;
         no_overflow("C_max", self.c_max())?;
@@ -303,6 +317,7 @@ impl HighProbabilityBound {
     /// let b = HighProbabilityBound { direction: -1.0, linear_lower: 1.0, linear_upper: 4.0, quadratic: 2.0 };
     /// assert_eq!(b.vertex(), -0.25);
     /// ```
+    #[inline]
     pub fn vertex(&self) -> f64 {
         self.direction * self.linear_lower / (2.0 * self.quadratic)
     }
@@ -320,6 +335,7 @@ impl HighProbabilityBound {
     /// let b = HighProbabilityBound { direction: 1.0, linear_lower: 1.0, linear_upper: 4.0, quadratic: 2.0 };
     /// assert_eq!(b.c_max(), 0.125);
     /// ```
+    #[inline]
     pub fn c_max(&self) -> f64 {
         self.linear_lower * (self.linear_lower / (2.0 * self.quadratic)) / 2.0
     }
@@ -344,11 +360,12 @@ impl HighProbabilityBound {
     /// assert!(s.lo > t.lo); // fewer negative steps are safe
     /// # Ok::<(), sepg_bounds::BoundsError>(())
     /// ```
+    #[inline]
     pub fn safe_step(&self, required: f64, form: HpForm) -> Result<StepOutcome, BoundsError> {
         finite("required", required)?;
         match form {
             HpForm::Thesis => {
-                solve_quadratic(self.direction * self.linear_lower, self.quadratic, required)
+                Parabola::new(self.direction * self.linear_lower, self.quadratic).solve(required)
             }
             HpForm::SignAware => solve_sign_aware(
                 self.direction,
@@ -360,13 +377,13 @@ impl HighProbabilityBound {
         }
     }
 
-    /// The interval of [`Self::safe_step`] when it returns a feasible one, else `None`
-    /// (`outcome::feasible_interval`).
+    /// The interval of [`Self::safe_step`] when it returns a feasible one, bit for bit, else
+    /// `None` (see [`Parabola::feasible`]).
     #[inline(always)]
-    pub(crate) fn feasible_step(&self, required: f64, form: HpForm) -> Option<SafeInterval> {
+    pub fn feasible_step(&self, required: f64, form: HpForm) -> Option<SafeInterval> {
         match form {
             HpForm::Thesis => {
-                feasible_interval(self.direction * self.linear_lower, self.quadratic, required)
+                Parabola::new(self.direction * self.linear_lower, self.quadratic).feasible(required)
             }
             HpForm::SignAware => feasible_sign_aware(
                 self.direction,
@@ -428,6 +445,23 @@ pub fn v_safe_step(
     )
 }
 
+/// [`v_safe_step`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
+pub fn v_safe_step_at(
+    p: &Penalties,
+    grad_v_hat: &[f64],
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
+    safe_step_or_below_noise(
+        HighProbabilityBound::v_update_at(p, grad_v_hat, eps)?,
+        required,
+        form,
+    )
+}
+
 /// Safe steps of Theorem 4.8 (eq. (4.29)) along an estimated ∇_w J, or
 /// [`StepOutcome::BelowNoise`].
 ///
@@ -454,6 +488,23 @@ pub fn w_safe_step_along_j(
     finite("required", required)?;
     safe_step_or_below_noise(
         HighProbabilityBound::w_along_j(k, sigma, grad_w_j_hat, eps)?,
+        required,
+        form,
+    )
+}
+
+/// [`w_safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
+pub fn w_safe_step_along_j_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_j_at(p, grad_w_j_hat, eps)?,
         required,
         form,
     )
@@ -490,6 +541,25 @@ pub fn w_safe_step_along_l(
     finite("required", required)?;
     safe_step_or_below_noise(
         HighProbabilityBound::w_along_l(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
+        required,
+        form,
+    )
+}
+
+/// [`w_safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with the
+/// penalty of their family; the same errors, without validating σ again.
+pub fn w_safe_step_along_l_at(
+    p: &Penalties,
+    grad_w_j_hat: f64,
+    eps_j: f64,
+    grad_w_l_hat: f64,
+    eps_l: f64,
+    required: f64,
+    form: HpForm,
+) -> Result<StepOutcome, BoundsError> {
+    finite("required", required)?;
+    safe_step_or_below_noise(
+        HighProbabilityBound::w_along_l_at(p, grad_w_j_hat, eps_j, grad_w_l_hat, eps_l)?,
         required,
         form,
     )

@@ -4,9 +4,20 @@
 //! [`BoundsError`] instead of panicking or producing NaN. Requirements that no step can meet
 //! are an ordinary outcome ([`outcome::StepOutcome::Infeasible`]), not an error.
 //!
+//! This crate knows nothing of rounding errors: its formulas are the thesis's, evaluated in
+//! `f64`. The `sepg-certified` crate builds on it the steps whose guarantee survives rounding
+//! (interval arithmetic and a-priori error bounds); the dependency goes one way only.
+//!
+//! The vocabulary, re-exported here: [`TaskConstants`] (validated once), [`Penalties`] (c and
+//! d of a [`Family`] at one σ, validated once), [`Parabola`] (the bound a·x − b·x² that every
+//! step rule solves), and the outcomes [`StepOutcome`] and [`SafeInterval`].
+//!
 //! | module | thesis |
 //! |---|---|
 //! | [`constants`] | ψ (Lemma A.1), c (Thms 3.14, 4.2), d (Thm 4.3), ∂c/∂σ |
+//! | [`penalties`] | c and d of one family of constants at one σ, evaluated once |
+//! | [`parabola`] | the parabola a·x − b·x² of Theorems 4.2–4.9 and its safe interval |
+//! | [`outcome`] | the outcome of a safe-step computation |
 //! | [`pirotta`] | Theorem 3.10, Corollary 3.11, Theorem 3.12 |
 //! | [`papini`] | Theorem 3.14 |
 //! | [`batch_size`] | Corollary 3.13 |
@@ -17,8 +28,6 @@
 //! | [`greedy`] | Section 4.3.4 (multi-dimensional greedy-coordinate updates) |
 //! | [`rigorous`] | Theorem 4.3 without neglected terms (Lemmas A.1–A.3) |
 //! | [`budget`] | Definition 4.3, Theorem 4.1, eqs. (4.13)–(4.14) |
-//! | [`interval`] | outward-rounded interval arithmetic |
-//! | [`certified`] | certified safe steps: the bounds above evaluated in interval arithmetic |
 //! | [`exploring`] | the exploring w-update: Theorem 4.3 with the confidence on ∇_w J only |
 //!
 //! ```
@@ -30,22 +39,27 @@
 //! # Ok::<(), sepg_bounds::BoundsError>(())
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod batch_size;
 pub mod budget;
-pub mod certified;
 pub mod constants;
 pub mod error;
 pub mod exploring;
 pub mod greedy;
 pub mod high_probability;
-pub mod interval;
 pub mod outcome;
 pub mod papini;
+pub mod parabola;
+pub mod penalties;
 pub mod pirotta;
 pub mod rigorous;
-mod rounding;
 pub mod surrogate;
 pub mod v_update;
 pub mod w_update;
 
+pub use constants::TaskConstants;
 pub use error::BoundsError;
+pub use outcome::{SafeInterval, StepOutcome};
+pub use parabola::Parabola;
+pub use penalties::{Family, Penalties};

@@ -1,9 +1,10 @@
 //! The non-scalar step size of Papini et al. (Theorem 3.14): the bound for a diagonal step
 //! matrix Λ and its maximiser, the greedy-coordinate step.
 
-use crate::constants::{TaskConstants, c};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite_vector, inf_norm, no_overflow, same_length};
 use crate::greedy::argmax_abs;
+use crate::penalties::Penalties;
 
 /// Lower bound on J(θ + Λ∇J) − J(θ) for a diagonal step Λ = diag(α₁, …, α_m) (Theorem 3.14).
 ///
@@ -32,7 +33,16 @@ pub fn bound(
     finite_vector("grad", grad)?;
     finite_vector("steps", steps)?;
     same_length("grad", grad, "steps", steps)?;
-    let cc = c(k, sigma)?;
+    bound_at(&Penalties::thesis(k, sigma)?, grad, steps)
+}
+
+/// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_at(p: &Penalties, grad: &[f64], steps: &[f64]) -> Result<f64, BoundsError> {
+    finite_vector("grad", grad)?;
+    finite_vector("steps", steps)?;
+    same_length("grad", grad, "steps", steps)?;
+    let cc = p.c()?;
     let linear: f64 = grad.iter().zip(steps).map(|(g, a)| a * g * g).sum();
     let l1: f64 = grad.iter().zip(steps).map(|(g, a)| (a * g).abs()).sum();
     no_overflow("Theorem 3.14 bound", linear - cc * l1 * l1)
@@ -69,8 +79,15 @@ pub struct GreedyStep {
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn greedy_step(k: &TaskConstants, sigma: f64, grad: &[f64]) -> Result<GreedyStep, BoundsError> {
+    argmax_abs(grad)?;
+    greedy_step_at(&Penalties::thesis(k, sigma)?, grad)
+}
+
+/// [`greedy_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn greedy_step_at(p: &Penalties, grad: &[f64]) -> Result<GreedyStep, BoundsError> {
     let index = argmax_abs(grad)?;
-    let cc = c(k, sigma)?;
+    let cc = p.c()?;
     let alpha = no_overflow("alpha*", 1.0 / (2.0 * cc))?;
     let mut steps = vec![0.0; grad.len()];
     steps[index] = alpha;

@@ -2,10 +2,11 @@
 //! high-probability Theorem 3.12, for a Gaussian policy with fixed σ and the full-gradient
 //! update θ' = θ + α∇J.
 
-use crate::constants::{TaskConstants, c};
+use crate::constants::TaskConstants;
 use crate::error::{
     BoundsError, finite, finite_vector, inf_norm, no_overflow, non_negative, same_length,
 };
+use crate::penalties::Penalties;
 
 /// Outcome of the adaptive step-size rule of Corollary 3.11 / Theorem 3.12.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,7 +67,15 @@ fn squared_norms(x: &[f64]) -> Result<(f64, f64), BoundsError> {
 pub fn bound(k: &TaskConstants, sigma: f64, grad: &[f64], alpha: f64) -> Result<f64, BoundsError> {
     finite_vector("grad", grad)?;
     finite("alpha", alpha)?;
-    let cc = c(k, sigma)?;
+    bound_at(&Penalties::thesis(k, sigma)?, grad, alpha)
+}
+
+/// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_at(p: &Penalties, grad: &[f64], alpha: f64) -> Result<f64, BoundsError> {
+    finite_vector("grad", grad)?;
+    finite("alpha", alpha)?;
+    let cc = p.c()?;
     let (l2, l1) = squared_norms(grad)?;
     no_overflow("Theorem 3.10 bound", alpha * l2 - alpha * alpha * cc * l1)
 }
@@ -100,7 +109,14 @@ pub fn optimal_step(
     grad: &[f64],
 ) -> Result<AdaptiveStep, BoundsError> {
     finite_vector("grad", grad)?;
-    let cc = c(k, sigma)?;
+    optimal_step_at(&Penalties::thesis(k, sigma)?, grad)
+}
+
+/// [`optimal_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn optimal_step_at(p: &Penalties, grad: &[f64]) -> Result<AdaptiveStep, BoundsError> {
+    finite_vector("grad", grad)?;
+    let cc = p.c()?;
     if inf_norm(grad) == 0.0 {
         return Ok(AdaptiveStep::ZeroGradient);
     }
@@ -169,8 +185,21 @@ pub fn hp_bound(
     alpha: f64,
 ) -> Result<f64, BoundsError> {
     finite("alpha", alpha)?;
+    corrected(grad_hat, eps)?;
+    hp_bound_at(&Penalties::thesis(k, sigma)?, grad_hat, eps, alpha)
+}
+
+/// [`hp_bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn hp_bound_at(
+    p: &Penalties,
+    grad_hat: &[f64],
+    eps: &[f64],
+    alpha: f64,
+) -> Result<f64, BoundsError> {
+    finite("alpha", alpha)?;
     let (lower, upper) = corrected(grad_hat, eps)?;
-    let cc = c(k, sigma)?;
+    let cc = p.c()?;
     let (l2_lower, _) = squared_norms(&lower)?;
     let (_, l1_upper) = squared_norms(&upper)?;
     no_overflow(
@@ -206,8 +235,19 @@ pub fn hp_optimal_step(
     grad_hat: &[f64],
     eps: &[f64],
 ) -> Result<AdaptiveStep, BoundsError> {
+    corrected(grad_hat, eps)?;
+    hp_optimal_step_at(&Penalties::thesis(k, sigma)?, grad_hat, eps)
+}
+
+/// [`hp_optimal_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn hp_optimal_step_at(
+    p: &Penalties,
+    grad_hat: &[f64],
+    eps: &[f64],
+) -> Result<AdaptiveStep, BoundsError> {
     let (lower, upper) = corrected(grad_hat, eps)?;
-    let cc = c(k, sigma)?;
+    let cc = p.c()?;
     if inf_norm(&upper) == 0.0 {
         return Ok(AdaptiveStep::ZeroGradient);
     }

@@ -191,7 +191,7 @@ pub fn v_safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    crate::v_update::safe_step_with_c(c(k, sigma)?, grad_v, required)
+    crate::v_update::parabola(c(k, sigma)?, crate::error::inf_norm(grad_v))?.solve(required)
 }
 
 /// Maximum number of bisection steps (enough to exhaust f64 precision from any finite bracket).

@@ -3,11 +3,11 @@
 //! The update is the greedy-coordinate step (4.11) of size α on the coordinate with the largest
 //! |∇_{v_k} J|; every function takes the whole gradient ∇_v J and uses its ∞-norm.
 
-use crate::constants::{TaskConstants, c};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, finite_vector, inf_norm, no_overflow};
-use crate::outcome::{
-    SafeInterval, StepOutcome, feasible_interval, quadratic_c_max, solve_quadratic,
-};
+use crate::outcome::StepOutcome;
+use crate::parabola::Parabola;
+use crate::penalties::Penalties;
 
 /// The step size of maximal guaranteed improvement, α* = 1/(2c) (Theorem 4.2).
 ///
@@ -24,7 +24,13 @@ use crate::outcome::{
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn alpha_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    no_overflow("alpha*", 0.5 / c(k, sigma)?)
+    alpha_star_at(&Penalties::thesis(k, sigma)?)
+}
+
+/// [`alpha_star`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn alpha_star_at(p: &Penalties) -> Result<f64, BoundsError> {
+    no_overflow("alpha*", 0.5 / p.c()?)
 }
 
 /// The largest guaranteed improvement of the v-update, eq. (4.9).
@@ -45,8 +51,17 @@ pub fn alpha_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 pub fn c_max(k: &TaskConstants, sigma: f64, grad_v: &[f64]) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     let n = inf_norm(grad_v);
+    no_overflow("||grad_v||^2", n * n)?;
+    c_max_at(&Penalties::thesis(k, sigma)?, grad_v)
+}
+
+/// [`c_max`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn c_max_at(p: &Penalties, grad_v: &[f64]) -> Result<f64, BoundsError> {
+    finite_vector("grad_v", grad_v)?;
+    let n = inf_norm(grad_v);
     let n2 = no_overflow("||grad_v||^2", n * n)?;
-    quadratic_c_max(n2, c(k, sigma)? * n2)
+    Parabola::new(n2, p.c()? * n2).c_max()
 }
 
 /// The lower bound (4.8) on J(v', w) − J(v, w) for a greedy-coordinate step of size α.
@@ -76,7 +91,15 @@ pub fn bound(
 ) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("alpha", alpha)?;
-    bound_with_c(c(k, sigma)?, grad_v, alpha, "Theorem 4.2 bound")
+    bound_at(&Penalties::thesis(k, sigma)?, grad_v, alpha)
+}
+
+/// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_at(p: &Penalties, grad_v: &[f64], alpha: f64) -> Result<f64, BoundsError> {
+    finite_vector("grad_v", grad_v)?;
+    finite("alpha", alpha)?;
+    bound_with_c(p.c()?, grad_v, alpha, "Theorem 4.2 bound")
 }
 
 /// α‖∇_vJ‖∞² − α²·cc·‖∇_vJ‖∞² for a validated gradient and step and a penalty coefficient cc
@@ -127,34 +150,48 @@ pub fn safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    safe_step_with_c(c(k, sigma)?, grad_v, required)
+    parabola(Penalties::thesis(k, sigma)?.c()?, inf_norm(grad_v))?.solve(required)
 }
 
-/// The safe steps of eq. (4.10) for a validated gradient and requirement and a penalty
-/// coefficient cc: {α : α‖∇_vJ‖∞² − α²·cc·‖∇_vJ‖∞² ≥ C}.
-pub(crate) fn safe_step_with_c(
-    cc: f64,
+/// [`safe_step`] for penalties evaluated once ([`Penalties`]): the safe steps of eq. (4.10)
+/// with c = `p.c()`.
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, v_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let p = Penalties::thesis(&k, 1.0)?;
+/// assert_eq!(v_update::safe_step_at(&p, &[0.5], 0.0)?, v_update::safe_step(&k, 1.0, &[0.5], 0.0)?);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn safe_step_at(
+    p: &Penalties,
     grad_v: &[f64],
     required: f64,
 ) -> Result<StepOutcome, BoundsError> {
-    safe_step_with_norm(cc, inf_norm(grad_v), required)
+    finite_vector("grad_v", grad_v)?;
+    finite("required", required)?;
+    parabola(p.c()?, inf_norm(grad_v))?.solve(required)
 }
 
-/// [`safe_step_with_c`] for the norm n = ‖∇_vJ‖∞ of a validated gradient.
-#[inline]
-pub(crate) fn safe_step_with_norm(
-    cc: f64,
-    n: f64,
-    required: f64,
-) -> Result<StepOutcome, BoundsError> {
-    let n2 = no_overflow("||grad_v||^2", n * n)?;
-    solve_quadratic(n2, cc * n2, required)
-}
-
-/// The interval of [`safe_step_with_norm`] when it returns a feasible one, else `None`
-/// ([`feasible_interval`]).
+/// The parabola of Theorem 4.2 for the penalty coefficient `c` (the thesis's c, or the sound
+/// c of [`crate::rigorous::c`]) and the norm `norm` = ‖∇_v J‖∞ of a validated gradient.
+///
+/// # Formula
+///
+/// ```text
+/// B(α) = a·α − b·α²,   a = ‖∇_v J‖∞²,   b = c·‖∇_v J‖∞²
+/// ```
+///
+/// Errors: [`BoundsError::Overflow`] when ‖∇_v J‖∞² is not finite.
+///
+/// ```
+/// use sepg_bounds::v_update::parabola;
+/// let p = parabola(3.0, 0.5)?;
+/// assert_eq!((p.linear, p.quadratic), (0.25, 0.75));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
 #[inline(always)]
-pub(crate) fn feasible_with_norm(cc: f64, n: f64, required: f64) -> Option<SafeInterval> {
-    let n2 = n * n;
-    feasible_interval(n2, cc * n2, required)
+pub fn parabola(c: f64, norm: f64) -> Result<Parabola, BoundsError> {
+    let n2 = no_overflow("||grad_v||^2", norm * norm)?;
+    Ok(Parabola::new(n2, c * n2))
 }

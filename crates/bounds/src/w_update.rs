@@ -5,11 +5,11 @@
 //! σ = e^w is the standard deviation *before* the update; `grad_w_j` is ∇_w J and `grad_w_l`
 //! is ∇_w L (the surrogate gradient of [`crate::surrogate`]), both at (v^{t+1}, w^t).
 
-use crate::constants::{TaskConstants, d};
+use crate::constants::TaskConstants;
 use crate::error::{BoundsError, finite, no_overflow};
-use crate::outcome::{
-    SafeInterval, StepOutcome, feasible_interval, quadratic_c_max, solve_quadratic,
-};
+use crate::outcome::StepOutcome;
+use crate::parabola::Parabola;
+use crate::penalties::Penalties;
 
 /// β* = 1/(2d), the step of maximal guaranteed improvement along ∇_w J (Theorem 4.3).
 ///
@@ -26,7 +26,13 @@ use crate::outcome::{
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    no_overflow("beta*", 0.5 / d(k, sigma)?)
+    beta_star_at(&Penalties::thesis(k, sigma)?)
+}
+
+/// [`beta_star`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn beta_star_at(p: &Penalties) -> Result<f64, BoundsError> {
+    no_overflow("beta*", 0.5 / p.d()?)
 }
 
 /// The largest guaranteed improvement of the w-update, eq. (4.16) (also that of Theorem 4.5).
@@ -45,8 +51,16 @@ pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 /// ```
 pub fn c_max(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<f64, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
+    no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    c_max_at(&Penalties::thesis(k, sigma)?, grad_w_j)
+}
+
+/// [`c_max`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn c_max_at(p: &Penalties, grad_w_j: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    quadratic_c_max(g2, d(k, sigma)? * g2)
+    Parabola::new(g2, p.d()? * g2).c_max()
 }
 
 /// The lower bound (4.15) for the step Δw = β ∇_w J.
@@ -72,11 +86,17 @@ pub fn bound_along_j(
 ) -> Result<f64, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("beta", beta)?;
+    no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    bound_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j, beta)
+}
+
+/// [`bound_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_along_j_at(p: &Penalties, grad_w_j: f64, beta: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("beta", beta)?;
     let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    no_overflow(
-        "Theorem 4.3 bound",
-        beta * g2 - beta * beta * d(k, sigma)? * g2,
-    )
+    no_overflow("Theorem 4.3 bound", beta * g2 - beta * beta * p.d()? * g2)
 }
 
 /// The safe steps along ∇_w J for a required improvement νC (Theorem 4.3, eq. (4.17)).
@@ -106,29 +126,48 @@ pub fn safe_step_along_j(
 ) -> Result<StepOutcome, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
-    safe_step_along_j_with_d(d(k, sigma)?, grad_w_j, required)
+    parabola_along_j(Penalties::thesis(k, sigma)?.d()?, grad_w_j)?.solve(required)
 }
 
-/// The safe steps of eq. (4.17) for validated inputs and a given d(σ).
-pub(crate) fn safe_step_along_j_with_d(
-    dd: f64,
+/// [`safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let p = Penalties::thesis(&k, 1.0)?;
+/// let expected = w_update::safe_step_along_j(&k, 1.0, 0.3, 0.0)?;
+/// assert_eq!(w_update::safe_step_along_j_at(&p, 0.3, 0.0)?, expected);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn safe_step_along_j_at(
+    p: &Penalties,
     grad_w_j: f64,
     required: f64,
 ) -> Result<StepOutcome, BoundsError> {
-    let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    solve_quadratic(g2, dd * g2, required)
+    finite("grad_w_j", grad_w_j)?;
+    finite("required", required)?;
+    parabola_along_j(p.d()?, grad_w_j)?.solve(required)
 }
 
-/// The interval of [`safe_step_along_j_with_d`] when it returns a feasible one, else `None`
-/// ([`feasible_interval`]).
+/// The parabola of Theorem 4.3 (eq. (4.15)) for the penalty `d` and a finite ∇_w J.
+///
+/// # Formula
+///
+/// ```text
+/// B(β) = a·β − b·β²,   a = (∇_w J)²,   b = d·(∇_w J)²
+/// ```
+///
+/// Errors: [`BoundsError::Overflow`] when (∇_w J)² is not finite.
+///
+/// ```
+/// let p = sepg_bounds::w_update::parabola_along_j(2.0, 0.5)?;
+/// assert_eq!((p.linear, p.quadratic), (0.25, 0.5));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
 #[inline(always)]
-pub(crate) fn feasible_along_j_with_d(
-    dd: f64,
-    grad_w_j: f64,
-    required: f64,
-) -> Option<SafeInterval> {
-    let g2 = grad_w_j * grad_w_j;
-    feasible_interval(g2, dd * g2, required)
+pub fn parabola_along_j(d: f64, grad_w_j: f64) -> Result<Parabola, BoundsError> {
+    let g2 = no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
+    Ok(Parabola::new(g2, d * g2))
 }
 
 /// The lower bound of Theorem 4.5 for the step Δw = β ∇_w L (β of either sign).
@@ -157,12 +196,25 @@ pub fn bound_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("beta", beta)?;
+    no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
+    no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
+    bound_along_l_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l, beta)
+}
+
+/// [`bound_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn bound_along_l_at(
+    p: &Penalties,
+    grad_w_j: f64,
+    grad_w_l: f64,
+    beta: f64,
+) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("beta", beta)?;
     let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
     let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
-    no_overflow(
-        "Theorem 4.5 bound",
-        beta * lj - beta * beta * d(k, sigma)? * l2,
-    )
+    no_overflow("Theorem 4.5 bound", beta * lj - beta * beta * p.d()? * l2)
 }
 
 /// β̃ = ∇_w J / (2 d ∇_w L), the step along ∇_w L of maximal guaranteed improvement
@@ -197,7 +249,22 @@ pub fn beta_tilde(
             domain: "non-zero reals",
         });
     }
-    no_overflow("beta~", grad_w_j / (2.0 * d(k, sigma)? * grad_w_l))
+    beta_tilde_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l)
+}
+
+/// [`beta_tilde`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
+/// family; the same errors, without validating σ again.
+pub fn beta_tilde_at(p: &Penalties, grad_w_j: f64, grad_w_l: f64) -> Result<f64, BoundsError> {
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    if grad_w_l == 0.0 {
+        return Err(BoundsError::OutOfDomain {
+            name: "grad_w_l",
+            value: grad_w_l,
+            domain: "non-zero reals",
+        });
+    }
+    no_overflow("beta~", grad_w_j / (2.0 * p.d()? * grad_w_l))
 }
 
 /// The safe steps along ∇_w L for a required improvement νC (Theorem 4.5, eq. (4.19)).
@@ -232,29 +299,50 @@ pub fn safe_step_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
-    safe_step_along_l_with_d(d(k, sigma)?, grad_w_j, grad_w_l, required)
+    let d = Penalties::thesis(k, sigma)?.d()?;
+    parabola_along_l(d, grad_w_j, grad_w_l)?.solve(required)
 }
 
-/// The safe steps of eq. (4.19) for validated inputs and a given d(σ).
-pub(crate) fn safe_step_along_l_with_d(
-    dd: f64,
+/// [`safe_step_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
+///
+/// ```
+/// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, w_update};
+/// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+/// let p = Penalties::thesis(&k, 1.0)?;
+/// let expected = w_update::safe_step_along_l(&k, 1.0, 0.3, -2.0, -0.1)?;
+/// assert_eq!(w_update::safe_step_along_l_at(&p, 0.3, -2.0, -0.1)?, expected);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn safe_step_along_l_at(
+    p: &Penalties,
     grad_w_j: f64,
     grad_w_l: f64,
     required: f64,
 ) -> Result<StepOutcome, BoundsError> {
-    let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
-    let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
-    solve_quadratic(lj, dd * l2, required)
+    finite("grad_w_j", grad_w_j)?;
+    finite("grad_w_l", grad_w_l)?;
+    finite("required", required)?;
+    parabola_along_l(p.d()?, grad_w_j, grad_w_l)?.solve(required)
 }
 
-/// The interval of [`safe_step_along_l_with_d`] when it returns a feasible one, else `None`
-/// ([`feasible_interval`]).
+/// The parabola of Theorem 4.5 for the penalty `d` and finite ∇_w J, ∇_w L.
+///
+/// # Formula
+///
+/// ```text
+/// B(β) = a·β − b·β²,   a = ∇_w L·∇_w J,   b = d·(∇_w L)²
+/// ```
+///
+/// Errors: [`BoundsError::Overflow`] when ∇_w L·∇_w J or (∇_w L)² is not finite.
+///
+/// ```
+/// let p = sepg_bounds::w_update::parabola_along_l(2.0, 0.5, -2.0)?;
+/// assert_eq!((p.linear, p.quadratic), (-1.0, 8.0));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
 #[inline(always)]
-pub(crate) fn feasible_along_l_with_d(
-    dd: f64,
-    grad_w_j: f64,
-    grad_w_l: f64,
-    required: f64,
-) -> Option<SafeInterval> {
-    feasible_interval(grad_w_l * grad_w_j, dd * (grad_w_l * grad_w_l), required)
+pub fn parabola_along_l(d: f64, grad_w_j: f64, grad_w_l: f64) -> Result<Parabola, BoundsError> {
+    let lj = no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
+    let l2 = no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
+    Ok(Parabola::new(lj, d * l2))
 }

@@ -1,5 +1,7 @@
-//! Every quantity of `sepg_bounds`, one Python function per Rust function, named
-//! `<module>_<function>` after the Rust path (`v_update::safe_step` → `v_update_safe_step`),
+//! Every quantity of `sepg_bounds` and the certified steps of `sepg_certified`, one Python
+//! function per Rust function, named `<module>_<function>` after the Rust path
+//! (`v_update::safe_step` → `v_update_safe_step`, `sepg_certified::v_safe_step` →
+//! `certified_v_safe_step`),
 //! and its classes: `StepOutcome`, `HighProbabilityBound`, `Budget`, `ExploringBound`, and
 //! the interval arithmetic of the certified steps (`Interval`, `Enclosure`, `Certified`).
 //! Vectors are any one-dimensional array-like of floats; steps and improvements are in the
@@ -8,17 +10,18 @@
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use sepg_bounds::budget::{self, Budget};
-use sepg_bounds::certified::{
-    self, Certified, EnclosedBound, ExploringEnclosure, HpEnclosure, Quadratic, RigorousEnclosure,
-};
 use sepg_bounds::exploring::{self, ExploringBound};
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
-use sepg_bounds::interval::Interval;
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::pirotta::AdaptiveStep;
 use sepg_bounds::{
     BoundsError, batch_size, constants, greedy, papini, pirotta, rigorous, surrogate, v_update,
     w_update,
+};
+use sepg_certified::Interval;
+use sepg_certified::{
+    self as certified, Certified, EnclosedBound, ExploringEnclosure, HpEnclosure, Quadratic,
+    RigorousEnclosure,
 };
 
 use crate::{PyTaskConstants, invalid, vector};

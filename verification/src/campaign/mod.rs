@@ -1,4 +1,4 @@
-//! The exact-arithmetic campaign for certified safe steps (`sepg_bounds::certified`).
+//! The exact-arithmetic campaign for certified safe steps (`sepg_certified`).
 //!
 //! For every input configuration and every bound form (Theorems 4.2, 4.3, 4.5, 4.7–4.9 in
 //! both high-probability forms, the rigorous w-bound along ∇_wJ and ∇_wL with the real-line
@@ -28,11 +28,11 @@ use std::cell::OnceCell;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
-use sepg_bounds::certified::{self, Certified};
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{exploring, pirotta, rigorous, v_update, w_update};
+use sepg_certified::{self as certified, Certified};
 
 use sepg_algo::solver::realise::{CoordinateBound, realise};
 

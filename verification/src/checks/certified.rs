@@ -1,4 +1,4 @@
-//! Certified safe steps (`sepg_bounds::certified`) against exact arithmetic.
+//! Certified safe steps (`sepg_certified`) against exact arithmetic.
 
 use crate::campaign::{CampaignConfig, FORMS, adversarial_len, run};
 use crate::check::{

@@ -421,7 +421,7 @@ impl CheckedConfig {
         &self.constants
     }
 
-    /// Whether SEPG takes certified steps (`sepg_bounds::certified`, the default): every
+    /// Whether SEPG takes certified steps (`sepg_certified`, the default): every
     /// v- and w-step, and the LV target, is a step whose bound, evaluated in outward-rounded
     /// interval arithmetic with the inputs taken as exact, meets its requirement.
     pub fn certified(&self) -> bool {

@@ -69,7 +69,7 @@ pub struct Record {
     /// the trajectories that terminate early (Mountain Car).
     pub steps: u64,
     /// Whether the v-step's bound was certified in interval arithmetic to meet its
-    /// requirement (`sepg_bounds::certified`): `Some(true)` certified, `Some(false)` the
+    /// requirement (`sepg_certified`): `Some(true)` certified, `Some(false)` the
     /// requirement was infeasible or within rounding of C_max (no `f64` step certifies it;
     /// `infeasible_v` is then set and the vertex taken), `None` when certification is off, no
     /// step was taken, or the algorithm has no safe step.

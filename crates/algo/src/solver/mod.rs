@@ -223,7 +223,7 @@ pub struct CollectedConfig {
 }
 
 impl PolicySolver {
-    /// Turns certified steps (`sepg_bounds::certified`, on by default) on or off for this
+    /// Turns certified steps (`sepg_certified`, on by default) on or off for this
     /// solver, e.g. one built by [`PolicySolver::with_collector`]; see
     /// [`CheckedConfig::with_certified_steps`].
     pub fn with_certified_steps(mut self, on: bool) -> Self {

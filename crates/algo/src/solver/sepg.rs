@@ -72,7 +72,7 @@ pub(crate) struct Setup<'a> {
     pub(crate) n: usize,
     /// The remaining choices ([`SepgOptions`]).
     pub(crate) opts: &'a SepgOptions,
-    /// Certified steps (`sepg_bounds::certified`).
+    /// Certified steps (`sepg_certified`).
     pub(crate) certify: bool,
 }
 

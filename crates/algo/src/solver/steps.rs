@@ -3,15 +3,15 @@
 //! Exact gradients use Theorems 4.2, 4.3 and 4.5 directly; estimated gradients use their
 //! high-probability versions (Theorems 4.7–4.9) in the sign-aware form, which keeps the
 //! guarantee for steps against the estimated direction (`HpForm::SignAware`, docs/THEOREMS.md).
-//! With certification on (the default), every step comes from `sepg_bounds::certified`: its
+//! With certification on (the default), every step comes from `sepg_certified`: its
 //! bound, evaluated in interval arithmetic, meets the requirement.
-use sepg_bounds::certified::{self, Certified};
 use sepg_bounds::constants::{TaskConstants, c};
 use sepg_bounds::exploring::{ExploringBound, w_exploring_step};
 use sepg_bounds::greedy::argmax_abs;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::{BoundsError, pirotta, surrogate, v_update, w_update};
+use sepg_certified::{self as certified, Certified};
 
 use crate::core::error::RunError;
 use crate::core::options::{WDirection, WStep};

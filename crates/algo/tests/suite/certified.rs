@@ -1,4 +1,4 @@
-//! Certified steps (`sepg_bounds::certified`) are the default of every SEPG variant, can be
+//! Certified steps (`sepg_certified`) are the default of every SEPG variant, can be
 //! turned off, and are recorded. That a certified step meets its requirement in exact
 //! arithmetic is the subject of the exact campaign of `sepg-verification`; here the plumbing.
 use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};

@@ -1,7 +1,9 @@
 //! Reference implementations written from the thesis formulas, independent of the crate's code
 //! paths, and a golden-section maximiser.
 
+use approx::relative_eq;
 use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::outcome::{SafeInterval, StepOutcome};
 
 /// c(σ) of Theorem 3.14 evaluated straight from the printed formula.
 pub fn c_ref(k: &TaskConstants, sigma: f64) -> f64 {
@@ -107,4 +109,62 @@ pub fn presets() -> Vec<TaskConstants> {
         TaskConstants::new(0.9, 100.0, 1.0, 2.0).unwrap(),
         TaskConstants::new(0.0, 1.0, 0.5, 0.25).unwrap(),
     ]
+}
+
+/// A bound given as a function returning (value, scale of its terms).
+pub fn check_interval(bound: &dyn Fn(f64) -> (f64, f64), s: &SafeInterval, required: f64) {
+    for x in [s.lo, s.hi] {
+        let (v, scale) = bound(x);
+        assert!(
+            relative_eq!(v, required, epsilon = 1e-10 * scale, max_relative = 1e-10),
+            "B({x}) = {v}, C = {required}"
+        );
+    }
+    let span = s.hi.abs().max(s.lo.abs());
+    for i in 1..20 {
+        let x = s.lo + (s.hi - s.lo) * f64::from(i) / 20.0;
+        let (v, scale) = bound(x);
+        assert!(
+            v >= required - 1e-12 * scale,
+            "inside: B({x}) = {v} < C = {required}"
+        );
+    }
+    let offset = 1e-4 * (s.hi - s.lo) + 1e-6 * span;
+    for x in [s.lo - offset, s.hi + offset] {
+        assert!(bound(x).0 < required, "outside: B({x}) ≥ C = {required}");
+    }
+    let slack = 1e-12 * span;
+    assert!(s.lo - slack <= s.vertex && s.vertex <= s.hi + slack);
+}
+
+pub fn feasible(o: StepOutcome) -> SafeInterval {
+    match o {
+        StepOutcome::Feasible(s) => s,
+        other => panic!("expected a feasible outcome, got {other:?}"),
+    }
+}
+
+/// Quadratic a x − b x² with its term scale.
+pub fn quad(a: f64, b: f64) -> impl Fn(f64) -> (f64, f64) {
+    move |x| (a * x - b * x * x, (a * x).abs().max(b * x * x))
+}
+
+/// Required improvements as fractions of C_max: required improvements, C = 0 and bounded
+/// worsenings down to −10 C_max, plus tiny fractions where naive formulas cancel.
+pub const FRACTIONS: [f64; 9] = [1.0, 0.999_999, 0.75, 1e-6, 0.0, -1e-6, -0.3, -2.0, -10.0];
+
+pub const SIGMAS: [f64; 3] = [0.1, 0.5, 2.0];
+
+pub fn l1sq(x: &[f64]) -> f64 {
+    x.iter().map(|v| v.abs()).sum::<f64>().powi(2)
+}
+
+pub fn l2sq(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum()
+}
+
+/// Maximises a·x − b·x² (b > 0) numerically over the bracket between its roots.
+pub fn numeric_vertex(poly: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let root = a / b;
+    golden_max(poly, root.min(0.0) - 1e-300, root.max(0.0) + 1e-300)
 }

@@ -1,11 +1,19 @@
-mod batch_budget;
+//! One file per file of `src/` (`checks/<file>.rs` tests `src/<file>.rs`), plus `common`
+//! (reference implementations and helpers) and `properties` (property-based checks across
+//! modules).
+mod batch_size;
+mod budget;
 mod common;
-mod errors;
+mod constants;
+mod error;
 mod exploring;
 mod high_probability;
-mod interval;
-mod intervals;
-mod optimal_steps;
+mod papini;
+mod parabola;
+mod penalties;
+mod pirotta;
 mod properties;
-mod psi_and_derivatives;
 mod rigorous;
+mod surrogate;
+mod v_update;
+mod w_update;

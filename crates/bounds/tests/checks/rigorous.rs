@@ -1,10 +1,10 @@
 //! The rigorous w-bound against its definition, its root-finder against the definition, and
 //! its relation to the thesis form.
 
+use super::common::check_interval;
 use super::common::{
     c_ref, close, d_ref, golden_max, k_mu_numeric, k_w_numeric, presets, psi_numeric,
 };
-use super::intervals::check_interval;
 use approx::{abs_diff_eq, assert_abs_diff_eq};
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::outcome::StepOutcome;

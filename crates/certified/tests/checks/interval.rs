@@ -1,11 +1,11 @@
-//! Outward rounding of `sepg_bounds::interval::Interval`: the exact result of each operation
+//! Outward rounding of `sepg_certified::Interval`: the exact result of each operation
 //! on two `f64` points lies in the computed interval. The exact result is known through
 //! error-free transformations: a + b = s + e (TwoSum), a·b = p + e with e = fma(a, b, −p), and
 //! a/b = q + r/b with r = fma(−q, b, a) exact; so the exact value is above the rounded one iff
 //! the error term is positive.
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
-use sepg_bounds::interval::Interval;
+use sepg_certified::Interval;
 
 /// Whether `i` contains the exact real `rounded + (error term with the sign of err)`.
 fn encloses(i: Interval, rounded: f64, err: f64) -> bool {

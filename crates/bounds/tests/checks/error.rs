@@ -157,3 +157,42 @@ fn safe_intervals_are_ordered_even_for_a_subnormal_c_max() {
     };
     assert!(s.lo <= s.vertex && s.vertex <= s.hi, "{s:?}");
 }
+
+/// σ is validated where the formulas first need c or d, after the inputs checked before it,
+/// as before the evaluated `Penalties` existed: an invalid σ together with an invalid gradient
+/// reports whichever the function checked first.
+#[test]
+fn sigma_is_validated_in_its_original_place() {
+    use sepg_bounds::exploring::ExploringBound;
+    use sepg_bounds::high_probability::HighProbabilityBound;
+    let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0).expect("valid");
+    let is_sigma = |e: BoundsError| matches!(e, BoundsError::OutOfDomain { name: "sigma", .. });
+    let is_grad = |e: BoundsError| matches!(e, BoundsError::NonFinite { name, .. } | BoundsError::EmptyVector { name } if name != "sigma");
+    let nan = f64::NAN;
+    // the gradient first
+    for e in [
+        v_update::safe_step(&k, -1.0, &[nan], 0.0).unwrap_err(),
+        v_update::c_max(&k, -1.0, &[]).unwrap_err(),
+        v_update::bound(&k, -1.0, &[nan], 0.1).unwrap_err(),
+        w_update::safe_step_along_j(&k, -1.0, nan, 0.0).unwrap_err(),
+        w_update::safe_step_along_l(&k, -1.0, 0.3, nan, 0.0).unwrap_err(),
+        w_update::bound_along_l(&k, -1.0, nan, 1.0, 0.1).unwrap_err(),
+        w_update::beta_tilde(&k, -1.0, nan, 1.0).unwrap_err(),
+        pirotta::bound(&k, -1.0, &[], 0.1).unwrap_err(),
+        pirotta::hp_bound(&k, -1.0, &[nan], &[0.1], 0.1).unwrap_err(),
+        papini::greedy_step(&k, -1.0, &[]).unwrap_err(),
+        ExploringBound::new(&k, -1.0, nan, 0.1).unwrap_err(),
+        v_safe_step(&k, -1.0, &[0.5], 0.1, nan, HpForm::Thesis).unwrap_err(),
+    ] {
+        assert!(is_grad(e), "{e:?}");
+    }
+    // σ first
+    for e in [
+        v_safe_step(&k, -1.0, &[nan], 0.1, 0.0, HpForm::Thesis).unwrap_err(),
+        HighProbabilityBound::v_update(&k, -1.0, &[nan], 0.1).unwrap_err(),
+        HighProbabilityBound::w_along_l(&k, -1.0, nan, 0.1, 1.0, 0.1).unwrap_err(),
+        v_update::alpha_star(&k, -1.0).unwrap_err(),
+    ] {
+        assert!(is_sigma(e), "{e:?}");
+    }
+}

@@ -1,4 +1,4 @@
-//! A-priori rounding-error bounds: the fast path of [`crate::certified`].
+//! A-priori rounding-error bounds: the fast path of [`crate::certificate`].
 //!
 //! Interval arithmetic rounds every end point outward, which costs about ten times a plain
 //! `f64` operation. The bounds of Theorems 4.2–4.9 and of the exploring w-update are, on each
@@ -17,19 +17,20 @@
 //! v̂ = v(1 + θ), |θ| ≤ γ_k, for the exact real v it stands for; the product of values with j
 //! and k roundings has j + k + 1, the sum of two non-negative ones max(j, k) + 1.
 //!
-//! - **c(σ)** as computed by [`crate::constants::c`] has 14 roundings: 1 − γ (1), the front
+//! - **c(σ)** as computed by [`sepg_bounds::constants::c`] has 14 roundings: 1 − γ (1), the front
 //!   factor R·M·M/((1−γ)(1−γ)) (6, counting 1 − γ twice), |A|/(√(2π)·σ·σ·σ) (6, of which 2
 //!   for the `f64` √(2π), which is within 1.6u of √(2π)), γ/(2(1−γ)σσ) (4), their sum (+1),
 //!   the final product (+1): 6 + 7 + 1.
-//! - **d(σ)** as computed by [`crate::constants::d`] has 12: R/((1−γ)(1−γ)) (4),
+//! - **d(σ)** as computed by [`sepg_bounds::constants::d`] has 12: R/((1−γ)(1−γ)) (4),
 //!   ψ·|A|/(2σ) (6, of which 4 for the `f64` ψ: it is computed with `exp`, and checked once to
-//!   lie within one ulp of the two-`f64` enclosure [`crate::certified::psi`], hence within
+//!   lie within one ulp of the two-`f64` enclosure [`crate::enclosure::psi`], hence within
 //!   2·2⁻⁵³ ≤ 3.9u·ψ of ψ), γ/(1−γ) (2), the sum (+1), the product (+1): 4 + 7 + 1.
 //!
 //!   Both counts need every intermediate result to be a normal number: that holds when R,
 //!   M_φ, |A| and σ lie in [2⁻¹⁰⁰, 2¹⁰⁰] and γ = 0 or γ ≥ 2⁻¹⁰⁰ (every intermediate then lies
 //!   within 2^±810), which [`apriori_box`] checks (the part on R, M_φ, |A|, γ once, when the
-//!   [`TaskConstants`] are built: [`task_in_box`]); outside it the interval path is used.
+//!   [`CertifiedTask`](crate::CertifiedTask) is built, or at each call: [`task_in_box`]); outside
+//!   it the interval path is used.
 //! - Further products are checked one at a time: a product whose result is normal obeys the
 //!   model ([`Rounded::mul`] returns `None` otherwise).
 //! - **The parabola at an exact x** ([`RoundedBound::enclose`]). With â = a(1 + θ_a),
@@ -56,9 +57,10 @@
 
 use std::sync::OnceLock;
 
-use crate::certified::{EnclosedBound, Quadratic};
-use crate::constants::{self, TaskConstants};
-use crate::high_probability::HpForm;
+use sepg_bounds::constants::{self, TaskConstants};
+use sepg_bounds::high_probability::HpForm;
+
+use crate::enclosure::{EnclosedBound, Quadratic};
 use crate::interval::Interval;
 
 /// u = 2⁻⁵³, the unit roundoff of `f64`.
@@ -74,31 +76,35 @@ const BOX_LO: f64 = 7.888_609_052_210_118e-31;
 const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
 
 /// Whether R, M_φ, |A| ∈ [2⁻¹⁰⁰, 2¹⁰⁰], γ = 0 or γ ≥ 2⁻¹⁰⁰, and the platform's ψ lies within
-/// one ulp of its enclosure (decided once, when the [`TaskConstants`] are built; the last
-/// condition only matters for d, and holds wherever `exp` is accurate to an ulp).
-pub(crate) fn task_in_box(gamma: f64, r_max: f64, m_phi: f64, action_volume: f64) -> bool {
+/// one ulp of its enclosure (the last condition only matters for d, holds wherever `exp` is
+/// accurate to an ulp, and is decided once per process): the range of the task constants that
+/// [`CertifiedTask`](crate::CertifiedTask) decides once.
+#[inline]
+pub(crate) fn task_in_box(k: &TaskConstants) -> bool {
     let inside = |x: f64| (BOX_LO..=BOX_HI).contains(&x);
-    inside(r_max)
-        && inside(m_phi)
-        && inside(action_volume)
+    let gamma = k.gamma();
+    inside(k.r_max())
+        && inside(k.m_phi())
+        && inside(k.action_volume())
         && (gamma == 0.0 || gamma >= BOX_LO)
         && psi_is_enclosed()
 }
 
 /// Whether the roundings counted for c(σ) and d(σ) hold: R, M_φ, |A|, σ ∈ [2⁻¹⁰⁰, 2¹⁰⁰] and
 /// γ = 0 or γ ≥ 2⁻¹⁰⁰, so that no intermediate result underflows or overflows, and the
-/// platform's ψ is enclosed ([`task_in_box`]).
+/// platform's ψ is enclosed (`in_range`: [`task_in_box`] of the task constants, decided once
+/// by a [`CertifiedTask`](crate::CertifiedTask) or at the call).
 #[inline]
-fn apriori_box(k: &TaskConstants, sigma: f64) -> bool {
-    k.in_rounding_box() && (BOX_LO..=BOX_HI).contains(&sigma)
+fn apriori_box(in_range: bool, sigma: f64) -> bool {
+    in_range && (BOX_LO..=BOX_HI).contains(&sigma)
 }
 
 /// Whether the platform's `f64` ψ ([`constants::psi`], which calls `exp`) lies within one ulp
-/// of the enclosure of [`crate::certified::psi`] (checked once).
+/// of the enclosure of [`crate::enclosure::psi`] (checked once).
 fn psi_is_enclosed() -> bool {
     static ENCLOSED: OnceLock<bool> = OnceLock::new();
     *ENCLOSED.get_or_init(|| {
-        let p = crate::certified::psi();
+        let p = crate::enclosure::psi();
         (p.lo().next_down()..=p.hi().next_up()).contains(&constants::psi())
     })
 }
@@ -163,8 +169,8 @@ impl Rounded {
 /// c(σ) with its 14 roundings, from `value` = [`constants::c`]`(k, sigma)`; `None` outside
 /// [`apriori_box`].
 #[inline]
-pub(crate) fn c(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
-    apriori_box(k, sigma).then_some(Rounded {
+pub(crate) fn c(in_range: bool, sigma: f64, value: f64) -> Option<Rounded> {
+    apriori_box(in_range, sigma).then_some(Rounded {
         value,
         roundings: C_ROUNDINGS,
     })
@@ -174,8 +180,8 @@ pub(crate) fn c(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
 /// [`apriori_box`] (which includes the check that the platform's ψ is within one ulp of its
 /// enclosure).
 #[inline]
-pub(crate) fn d(k: &TaskConstants, sigma: f64, value: f64) -> Option<Rounded> {
-    apriori_box(k, sigma).then_some(Rounded {
+pub(crate) fn d(in_range: bool, sigma: f64, value: f64) -> Option<Rounded> {
+    apriori_box(in_range, sigma).then_some(Rounded {
         value,
         roundings: D_ROUNDINGS,
     })

@@ -26,7 +26,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 /// [`Interval::exp`] rounds outward (module docs), so results enclose the exact reals.
 ///
 /// ```
-/// use sepg_bounds::interval::Interval;
+/// use sepg_certified::Interval;
 /// let third = Interval::point(1.0) / Interval::point(3.0);
 /// assert!(third.lo() < third.hi());
 /// assert!(third.lo() <= 1.0 / 3.0 && 1.0 / 3.0 <= third.hi());
@@ -67,7 +67,7 @@ impl Interval {
     /// The degenerate interval [x, x] (exact). NaN gives [`Interval::ENTIRE`].
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// assert_eq!(Interval::point(0.1).lo(), 0.1);
     /// assert_eq!(Interval::point(f64::NAN), Interval::ENTIRE);
     /// ```
@@ -83,7 +83,7 @@ impl Interval {
     /// [lo, hi], or `None` when lo > hi or either is NaN.
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// assert!(Interval::new(1.0, 2.0).is_some());
     /// assert!(Interval::new(2.0, 1.0).is_none());
     /// ```
@@ -113,7 +113,7 @@ impl Interval {
     /// Whether x ∈ [lo, hi].
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// assert!(Interval::new(1.0, 2.0).unwrap().contains(1.5));
     /// ```
     pub fn contains(&self, x: f64) -> bool {
@@ -128,7 +128,7 @@ impl Interval {
     /// hi − lo rounded up (an upper bound on the width).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// assert!(Interval::new(1.0, 2.0).unwrap().width() >= 1.0);
     /// ```
     pub fn width(&self) -> f64 {
@@ -147,7 +147,7 @@ impl Interval {
     /// The enclosure of x² (non-negative, tighter than x · x when 0 ∈ x).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let s = Interval::new(-1.0, 2.0).unwrap().sqr();
     /// assert_eq!(s.lo(), 0.0);
     /// assert!(s.hi() >= 4.0);
@@ -174,7 +174,7 @@ impl Interval {
     /// The enclosure of √x over the non-negative part of x (lower end ≥ 0).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let r = Interval::point(2.0).sqrt();
     /// assert!(r.lo() * r.lo() <= 2.0 && r.hi() * r.hi() >= 2.0);
     /// ```
@@ -191,7 +191,7 @@ impl Interval {
     /// docs); widened by two ulps on each side.
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let e = Interval::point(1.0).exp();
     /// assert!(e.contains(std::f64::consts::E));
     /// ```
@@ -206,7 +206,7 @@ impl Interval {
     /// widened by two ulps on each side.
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// assert!(Interval::point(1e-20).exp_m1().contains(1e-20));
     /// ```
     pub fn exp_m1(self) -> Self {
@@ -219,7 +219,7 @@ impl Interval {
     /// The enclosure of max(self, other), element-wise on the end points (exact).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let m = Interval::point(1.0).max(Interval::new(0.0, 2.0).unwrap());
     /// assert_eq!((m.lo(), m.hi()), (1.0, 2.0));
     /// ```
@@ -233,7 +233,7 @@ impl Interval {
     /// The enclosure of self · x for an exact `f64` x (two products instead of four).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let p = Interval::new(1.0, 2.0).unwrap().scale(-3.0);
     /// assert!(p.contains(-3.0) && p.contains(-6.0));
     /// ```
@@ -253,7 +253,7 @@ impl Interval {
     /// The enclosure of |x| (exact end points).
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let a = Interval::new(-3.0, 2.0).unwrap().abs();
     /// assert_eq!((a.lo(), a.hi()), (0.0, 3.0));
     /// assert_eq!(Interval::new(-3.0, -2.0).unwrap().abs(), Interval::new(2.0, 3.0).unwrap());
@@ -282,7 +282,7 @@ impl Interval {
     /// The convex hull of two intervals.
     ///
     /// ```
-    /// use sepg_bounds::interval::Interval;
+    /// use sepg_certified::Interval;
     /// let h = Interval::point(1.0).hull(Interval::point(3.0));
     /// assert!(h.contains(2.0));
     /// ```

@@ -1,0 +1,2 @@
+mod interval;
+mod steps;

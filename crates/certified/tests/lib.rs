@@ -1,0 +1,3 @@
+//! Integration tests of `sepg-certified`, compiled as a single binary.
+
+mod checks;
