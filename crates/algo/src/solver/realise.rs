@@ -23,10 +23,9 @@
 //! differs from the step's own certificate by the rounding of the update; the second differs
 //! from the thesis form by the Θ(Δ³) terms Theorem 4.3 neglects (docs/ERRATA.md §10).
 use sepg_bounds::BoundsError;
-use sepg_bounds::certified::{self, EnclosedBound, RigorousEnclosure};
 use sepg_bounds::constants::TaskConstants;
-use sepg_bounds::interval::Interval;
 use sepg_bounds::rigorous;
+use sepg_certified::{self as certified, EnclosedBound, Interval, RigorousEnclosure};
 
 /// A rigorous lower bound of J(x₀ + Δ) − J(x₀) for changes Δ of one coordinate (module
 /// docs), valid for every Δ at once on the confidence event of the coordinate's estimate.
