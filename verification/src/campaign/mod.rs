@@ -660,7 +660,7 @@ fn exact_bound(form: usize, c: &Case, ex: &Exact, x: f64) -> Option<Mp> {
 
 /// Parameter values the certified steps are applied to (one per case and form, by index):
 /// from small to large against the steps, so that rounding x₀ + Δ moves the realised change.
-const STARTS: [f64; 4] = [-0.1, -0.693_147_180_559_945_3, 1.0, -123.456];
+const STARTS: [f64; 4] = [-0.1, -std::f64::consts::LN_2, 1.0, -123.456];
 
 /// The coordinate change SEPG applies for a certified step of `form` on `c`: (the direction
 /// component that multiplies the step, ĝ of the moved coordinate, its width ε, whether it is a

@@ -49,13 +49,14 @@ pub enum WDirection {
 }
 
 /// The confidence widths ε of the sampled mode (Section 4.5).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub enum Confidence {
     /// Widths proven at every batch size from the task's constants R, M_φ, σ, γ and H
     /// (`sepg_estimators::proven`, docs/THEOREMS.md "Proven confidence widths"): the
     /// gradients a guarantee rests on are estimated by G(PO)MDP with a constant baseline, and
     /// ε_i is the sub-Gaussian (∇_v J) or sub-exponential (∇_w J) width of that estimator. The
     /// direction ∇̂_w L, which carries no guarantee, keeps Student-t widths.
+    #[default]
     SubGaussian,
     /// ε = 0: the estimates are used as if exact (the thesis-era code's default δ = 1).
     None,
@@ -64,12 +65,6 @@ pub enum Confidence {
         /// Multiplier of the Student-t quantile (> 0).
         factor: f64,
     },
-}
-
-impl Default for Confidence {
-    fn default() -> Self {
-        Confidence::SubGaussian
-    }
 }
 
 impl Confidence {
