@@ -31,21 +31,24 @@ fn run(dir: &Path, args: &[&str]) {
 
 /// A short exact run of `algo` on the `lqg` preset (clipped: audited with the DP oracle).
 fn exact_run(dir: &Path, algo: &str) {
-    run(
-        dir,
-        &[
-            "--env",
-            "lqg",
-            "--algo",
-            algo,
-            "--gradients",
-            "exact",
-            "--sigma0",
-            "0.5",
-            "--iterations",
-            "12",
-        ],
-    );
+    exact_run_with(dir, algo, &[]);
+}
+
+fn exact_run_with(dir: &Path, algo: &str, extra: &[&str]) {
+    let mut args = vec![
+        "--env",
+        "lqg",
+        "--algo",
+        algo,
+        "--gradients",
+        "exact",
+        "--sigma0",
+        "0.5",
+        "--iterations",
+        "12",
+    ];
+    args.extend_from_slice(extra);
+    run(dir, &args);
 }
 
 fn audit_json_with(dir: &Path, extra: &[&str]) -> (Option<i32>, serde_json::Value) {
@@ -136,6 +139,11 @@ fn set_statement(dir: &Path, kind: &str, scope: &str, delta: Option<f64>) {
         st["scope"] = scope.into();
         st["delta"] = delta.map_or(serde_json::Value::Null, Into::into);
         st["reasons"] = serde_json::json!([]);
+        // a run of the thesis's bookkeeping records `covers = none`; a statement set by hand
+        // covers what its variant's requirement covers
+        if st["covers"] == "none" {
+            st["covers"] = "exploratory".into();
+        }
     });
 }
 
@@ -378,9 +386,11 @@ fn a_clean_run_holds_and_an_injected_drop_breaks_it_at_its_iteration() {
 #[test]
 fn each_check_breaks_when_its_own_requirement_is_broken() {
     let tmp = tempfile::tempdir().expect("tempdir");
+    // the thesis's bookkeeping moves both blocks in every iteration (under the certified
+    // accounting an exact ZV run spends no budget on w); the statement is then set by hand
     let certain = |name: &str, algo: &str| {
         let dir = tmp.path().join(name);
-        exact_run(&dir, algo);
+        exact_run_with(&dir, algo, &["--accounting", "estimated"]);
         set_statement(&dir, "proven", "run", None);
         dir
     };
