@@ -7,6 +7,7 @@ mod chapter3;
 mod chapter4;
 mod exploring;
 mod lqg_exact;
+mod run_statement;
 pub(crate) mod sampled;
 
 use crate::check::{Check, Expected};
@@ -31,6 +32,7 @@ pub fn registry() -> Vec<Check> {
     checks.extend(algorithm::checks());
     checks.extend(certified::checks());
     checks.extend(exploring::checks());
+    checks.extend(run_statement::checks());
     for c in &mut checks {
         if c.meta.basis.is_empty() {
             c.meta.basis = default_basis(c.meta.expected).into();
