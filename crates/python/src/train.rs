@@ -10,7 +10,7 @@ use pyo3::types::PyModule;
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
-use sepg_algo::core::options::{Confidence, Schedule, SepgOptions};
+use sepg_algo::core::options::{Accounting, Confidence, Schedule, SepgOptions};
 use sepg_algo::core::seed::Block;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
@@ -246,11 +246,13 @@ impl Trainer {
     /// A trainer for `algorithm` (named as on the command line) with validated `constants`,
     /// `actions` action dimensions and `features` features; v⁰ (default −0.1 everywhere,
     /// action-major `v[j·p + i]`), σ⁰ (default 1), N trajectories per iteration, seed, δ,
-    /// initial budget B⁰ ≥ 0, and N₀, the trajectories of the reference batch that estimates
-    /// J(θ⁰) before the first iteration of SEPG (default 1000; 0 takes J(θ⁰) from the first
-    /// v-block as the thesis's pseudocode does; 1 is an error).
+    /// initial budget B⁰ ≥ 0, `accounting` ("certified", the default: requirements built on
+    /// the certified guarantees of the applied steps; "estimated": the thesis's bookkeeping
+    /// with estimated J), and N₀, the trajectories of the reference batch that estimates
+    /// J(θ⁰) before the first iteration of SEPG under the estimated bookkeeping (default 1000;
+    /// 0 takes J(θ⁰) from the first v-block as the thesis's pseudocode does; 1 is an error).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -271,6 +273,7 @@ impl Trainer {
         lr: Option<f64>,
         lr_w: Option<f64>,
         reference_batch: Option<usize>,
+        accounting: &str,
     ) -> PyResult<Self> {
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
@@ -328,6 +331,15 @@ impl Trainer {
         if let Some(n0) = reference_batch {
             options.reference_batch = n0;
         }
+        options.accounting = match accounting {
+            "certified" => Accounting::Certified,
+            "estimated" => Accounting::Estimated,
+            other => {
+                return Err(invalid(format!(
+                    "accounting = {other:?} must be \"certified\" or \"estimated\""
+                )));
+            }
+        };
         let solver = PolicySolver::with_collector(&config, Box::new(collector))
             .and_then(|s| s.with_options(options))
             .map_err(invalid)?;

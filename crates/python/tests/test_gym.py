@@ -21,15 +21,16 @@ def small_run(env, **kw):
 
 
 def test_same_seed_same_records_other_seed_other_records():
-    # A small reference batch of J(theta^0) keeps the test short; its 20 trajectories are
-    # collected before iteration 0, once for J(theta^0) of the exploratory policy and once
-    # for the target's (type-II requirement ZV): 2 x 20 + 3 iterations x 12.
-    a = small_run(MCC, reference_batch=20)
+    # The thesis's bookkeeping with a small reference batch of J(theta^0) keeps the test
+    # short; its 20 trajectories are collected before iteration 0, once for J(theta^0) of the
+    # exploratory policy and once for the target's (type-II requirement ZV): 2 x 20 + 3
+    # iterations x 12.
+    a = small_run(MCC, reference_batch=20, accounting="estimated")
     a.run(3)
-    b = small_run(MCC, reference_batch=20)
+    b = small_run(MCC, reference_batch=20, accounting="estimated")
     b.run(2)
     b.run(1)  # resuming between iterations changes nothing
-    c = small_run(MCC, seed=4, reference_batch=20)
+    c = small_run(MCC, seed=4, reference_batch=20, accounting="estimated")
     c.run(3)
     assert a.records == b.records
     assert a.records != c.records
@@ -152,7 +153,10 @@ def fake_collector(requests):
 def test_the_reference_batch_is_collected_once_before_the_first_iteration(reference_batch, first):
     k = sepg.TaskConstants(0.9, 1.0, 1.0, 2.0)
     requests = []
-    options = {} if reference_batch is None else {"reference_batch": reference_batch}
+    # the reference batch is the thesis's bookkeeping's; the certified accounting has none
+    options = {"accounting": "estimated"}
+    if reference_batch is not None:
+        options["reference_batch"] = reference_batch
     trainer = sepg.Trainer("sepg-zv", k, 1, 1, fake_collector(requests), n_trajectories=12, **options)
     records = json.loads(trainer.run(2))
     reference = [r for r in requests if r[1].startswith("reference")]
@@ -163,6 +167,17 @@ def test_the_reference_batch_is_collected_once_before_the_first_iteration(refere
     # Every trajectory asked for is counted, the reference batch once in iteration 0.
     assert records[-1]["trajectories"] == sum(r[2] for r in requests)
     assert sum(r[2] for r in requests if r[1] in ("v", "target", "w")) == 2 * 12
+
+
+def test_the_certified_accounting_collects_no_reference_batch_and_names_a_bad_value():
+    k = sepg.TaskConstants(0.9, 1.0, 1.0, 2.0)
+    requests = []
+    trainer = sepg.Trainer("sepg-zv", k, 1, 1, fake_collector(requests), n_trajectories=12)
+    records = json.loads(trainer.run(2))
+    assert [r for r in requests if r[1].startswith("reference")] == []
+    assert records[-1]["trajectories"] == 2 * 12
+    with pytest.raises(sepg.InvalidInputError, match="accounting"):
+        sepg.Trainer("sepg-zv", k, 1, 1, fake_collector([]), n_trajectories=12, accounting="thesis")
 
 
 def test_a_reference_batch_of_one_trajectory_is_refused():

@@ -243,9 +243,11 @@ class GymRun:
     is named as on the command line (``sepg-zv``, ``sepg-lv``, ``sepg-mi``, ``sepg-lb1``,
     ``sepg-lb2``, ``sepg-sim``, ``sepg-naive-w``, ``gpomdp-const``, ``gpomdp-adam``,
     ``adastep``); ``options`` are its hyper-parameters (``nu``, ``requirement``, ``alpha``,
-    ``beta``, ``lr``, ``lr_w``) and ``reference_batch``, the N0 trajectories that estimate
-    J(theta^0) before SEPG's first iteration (default 1000; 0 takes it from the first
-    v-block, as the thesis's pseudocode). ``horizon`` defaults to the environment's
+    ``beta``, ``lr``, ``lr_w``), ``accounting`` (``"certified"``, the default: requirements
+    built on the certified guarantees of the applied steps; ``"estimated"``: the thesis's
+    bookkeeping) and ``reference_batch``, the N0 trajectories that estimate J(theta^0) before
+    SEPG's first iteration under the estimated bookkeeping (default 1000; 0 takes it from the
+    first v-block, as the thesis's pseudocode). ``horizon`` defaults to the environment's
     ``max_episode_steps``.
     """
 
