@@ -1049,3 +1049,55 @@ fn help_documents_the_exit_statuses() {
         assert!(help.contains(line), "{line:?} in {help}");
     }
 }
+
+/// The review's case: SEPG-LB-II from the v-optimum of the clipped `lqg` (v⁰ at ∂J/∂v = 0,
+/// σ⁰ = 2), seed 0. With the thesis's bookkeeping one optimistic estimate at iteration 0 lets
+/// the budget spend a worsening the exact J does not have, and the exact budget stays negative
+/// for hundreds of iterations; the run records no statement (kind none), and the audit says
+/// `no-guarantee` (it used to say "holds") while still counting the exact failures. The same
+/// start with the certified accounting (and Student-t widths, so that steps are taken) keeps
+/// its requirement: no exact failure, and the verdict is `approximate`, never `holds`.
+#[test]
+fn the_reviews_lb2_run_from_the_optimum() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let start = [
+        "--env",
+        "lqg",
+        "--algo",
+        "sepg-lb2",
+        "--v0",
+        "-1.1221115976564946",
+        "--sigma0",
+        "2",
+        "--iterations",
+        "1000",
+        "--seed",
+        "0",
+        "--confidence",
+        "student-t",
+    ];
+    let thesis = tmp.path().join("thesis");
+    let mut args = start.to_vec();
+    args.extend_from_slice(&["--accounting", "estimated", "--schedule", "iteration"]);
+    run(&thesis, &args);
+    let (code, report) = audit_json(&thesis);
+    assert_eq!(code, Some(0), "{report}");
+    assert_eq!(report["verdict"], "no-guarantee", "{report}");
+    let budget = check(&report, "budget-exact");
+    let failed = budget["failed"].as_u64().expect("failed");
+    assert!(
+        failed >= 100,
+        "the exact budget broke in {failed} iterations: {report}"
+    );
+    assert_eq!(budget["first_failure"].as_u64(), Some(0), "{report}");
+
+    let sound = tmp.path().join("sound");
+    run(&sound, &start);
+    let (code, report) = audit_json(&sound);
+    assert_eq!(code, Some(0), "{report}");
+    assert_eq!(report["verdict"], "approximate", "{report}");
+    assert_eq!(report["statement"]["kind"], "approximate");
+    for c in report["checks"].as_array().expect("checks") {
+        assert_eq!(c["failed"].as_u64(), Some(0), "{c}");
+    }
+}
