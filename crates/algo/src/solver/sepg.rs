@@ -201,6 +201,88 @@ fn reference(
     Ok(())
 }
 
+/// One block of iteration t at (v, w) from `n` trajectories, counted into `counts`
+/// (trajectories, environment steps).
+fn counted(
+    source: &mut dyn GradientSource,
+    q: &Query<'_>,
+    counts: (&mut u64, &mut u64),
+) -> Result<Estimate, RunError> {
+    let e = source.estimate(q)?;
+    *counts.0 += e.trajectories;
+    *counts.1 += e.steps;
+    Ok(e)
+}
+
+/// The v-block of iteration t: Ĵ and ∇̂_v J at (v, w), plus the w-gradients SIM-ν (both) and
+/// LV (∇̂_w J, for its target) need from this batch.
+fn v_block(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    (iteration, v, w, n): (u64, &[f64], &[f64], usize),
+    counts: (&mut u64, &mut u64),
+) -> Result<Estimate, RunError> {
+    let sim = matches!(setup.req, Requirement::Sim { .. });
+    let need = Need {
+        grad_v: true,
+        grad_wj: sim || setup.req == Requirement::Lv,
+        grad_wl: sim && !setup.naive_w,
+        j_width: false,
+    };
+    let q = Query {
+        iteration,
+        block: Block::V,
+        v,
+        w: Some(w),
+        n,
+        need,
+    };
+    counted(source, &q, counts)
+}
+
+/// The w-block of iteration t: Ĵ, ∇̂_w J and (unless `naive_w`) ∇̂_w L at (v, w).
+fn w_block(
+    source: &mut dyn GradientSource,
+    naive_w: bool,
+    (iteration, v, w, n): (u64, &[f64], &[f64], usize),
+    counts: (&mut u64, &mut u64),
+) -> Result<Estimate, RunError> {
+    let need = Need {
+        grad_v: false,
+        grad_wj: true,
+        grad_wl: !naive_w,
+        j_width: false,
+    };
+    let q = Query {
+        iteration,
+        block: Block::W,
+        v,
+        w: Some(w),
+        n,
+        need,
+    };
+    counted(source, &q, counts)
+}
+
+/// The target block of iteration t (LV, ZV, SIM-ν): Ĵ of the target policy (v, `w`; `None`
+/// is the deterministic policy) from `n` trajectories, counted into `counts` (trajectories,
+/// environment steps).
+fn target_j(
+    source: &mut dyn GradientSource,
+    (iteration, v, w, n): (u64, &[f64], Option<&[f64]>, usize),
+    counts: (&mut u64, &mut u64),
+) -> Result<f64, RunError> {
+    let q = Query {
+        iteration,
+        block: Block::Target,
+        v,
+        w,
+        n,
+        need: Need::default(),
+    };
+    Ok(counted(source, &q, counts)?.j)
+}
+
 /// Runs SEPG iteration `state.iteration` with the fixed inputs `setup`.
 pub(crate) fn iterate(
     source: &mut dyn GradientSource,
@@ -230,35 +312,18 @@ pub(crate) fn iterate(
     };
     let mut j0 = state.j0;
     let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
-    let w_dir = Need {
-        grad_v: false,
-        grad_wj: true,
-        grad_wl: !naive_w,
-        j_width: false,
-    };
     let sim_nu = match req {
         Requirement::Sim { nu } => Some(nu),
         _ => None,
     };
-    let sim = sim_nu.is_some();
 
     // v-block: J(vᵗ, wᵗ) and ∇_v J (plus the w-gradients SIM-ν and LV need from this batch).
-    let need_v = Need {
-        grad_v: true,
-        grad_wj: sim || req == Requirement::Lv,
-        grad_wl: sim && !naive_w,
-        j_width: false,
-    };
-    let ev = source.estimate(&Query {
-        iteration: t,
-        block: Block::V,
-        v: &state.v,
-        w: Some(&state.w),
-        n: sizes[0],
-        need: need_v,
-    })?;
-    trajectories += ev.trajectories;
-    env_steps += ev.steps;
+    let ev = v_block(
+        source,
+        setup,
+        (t, &state.v, &state.w, sizes[0]),
+        (&mut trajectories, &mut env_steps),
+    )?;
     let j_t = ev.j;
     let j_base = *j0.get_or_insert(j_t);
     // The budget B (Definition 4.3) measures differences from the last J of each tracked
@@ -317,17 +382,11 @@ pub(crate) fn iterate(
         } else {
             None
         };
-        let et = source.estimate(&Query {
-            iteration: t,
-            block: Block::Target,
-            v: &state.v,
-            w: w_target.as_deref(),
-            n: sizes[1],
-            need: Need::default(),
-        })?;
-        trajectories += et.trajectories;
-        env_steps += et.steps;
-        j_target = et.j;
+        j_target = target_j(
+            source,
+            (t, &state.v, w_target.as_deref(), sizes[1]),
+            (&mut trajectories, &mut env_steps),
+        )?;
         if state.target_prev.is_some() {
             budget.record_target(j_target).map_err(budget_error)?;
         }
@@ -341,16 +400,12 @@ pub(crate) fn iterate(
         apply(&mut w_new, &plan);
         (None, required_w, BlockLog::from_plan(&plan), j_t)
     } else {
-        let ew = source.estimate(&Query {
-            iteration: t,
-            block: Block::W,
-            v: &v_new,
-            w: Some(&state.w),
-            n: sizes[sizes.len() - 1],
-            need: w_dir,
-        })?;
-        trajectories += ew.trajectories;
-        env_steps += ew.steps;
+        let ew = w_block(
+            source,
+            naive_w,
+            (t, &v_new, &state.w, sizes[sizes.len() - 1]),
+            (&mut trajectories, &mut env_steps),
+        )?;
         // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
         budget.record_exploratory(ew.j).map_err(budget_error)?;
         let required_w = match (req, full) {
@@ -631,22 +686,12 @@ fn iterate_certified(
     };
     let required_v = allowed(cv);
 
-    let need_v = Need {
-        grad_v: true,
-        grad_wj: sim || req == Requirement::Lv,
-        grad_wl: sim && !naive_w,
-        j_width: false,
-    };
-    let ev = source.estimate(&Query {
-        iteration: t,
-        block: Block::V,
-        v: &state.v,
-        w: Some(&state.w),
-        n: sizes[0],
-        need: need_v,
-    })?;
-    trajectories += ev.trajectories;
-    env_steps += ev.steps;
+    let ev = v_block(
+        source,
+        setup,
+        (t, &state.v, &state.w, sizes[0]),
+        (&mut trajectories, &mut env_steps),
+    )?;
     let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
         "the v-block returned no gradient".into(),
     ))?;
@@ -691,17 +736,11 @@ fn iterate_certified(
         } else {
             None
         };
-        let et = source.estimate(&Query {
-            iteration: t,
-            block: Block::Target,
-            v: &state.v,
-            w: w_target.as_deref(),
-            n: sizes[1],
-            need: Need::default(),
-        })?;
-        trajectories += et.trajectories;
-        env_steps += et.steps;
-        j_target = et.j;
+        j_target = target_j(
+            source,
+            (t, &state.v, w_target.as_deref(), sizes[1]),
+            (&mut trajectories, &mut env_steps),
+        )?;
     }
 
     // w-block (SIM-ν: from the v-block's batch).
@@ -714,21 +753,12 @@ fn iterate_certified(
     let (j_after_v, ew) = if sim {
         (None, None)
     } else {
-        let ew = source.estimate(&Query {
-            iteration: t,
-            block: Block::W,
-            v: &v_new,
-            w: Some(&state.w),
-            n: sizes[sizes.len() - 1],
-            need: Need {
-                grad_v: false,
-                grad_wj: true,
-                grad_wl: !naive_w,
-                j_width: false,
-            },
-        })?;
-        trajectories += ew.trajectories;
-        env_steps += ew.steps;
+        let ew = w_block(
+            source,
+            naive_w,
+            (t, &v_new, &state.w, sizes[sizes.len() - 1]),
+            (&mut trajectories, &mut env_steps),
+        )?;
         (Some(ew.j), Some(ew))
     };
     let e_w = ew.as_ref().unwrap_or(&ev);
