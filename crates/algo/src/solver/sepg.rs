@@ -674,7 +674,13 @@ fn iterate_certified(
         _ => None,
     };
     let sim = sim_nu.is_some();
-    let b0 = state.budget;
+    // LB-I's surplus starts at 0 whatever B⁰ (its requirement is J ≥ J(θ⁰), Table 4.1); the
+    // type-II budgets start at B⁰
+    let b0 = if t == 0 && matches!(req, Requirement::LbI { .. }) {
+        0.0
+    } else {
+        state.budget
+    };
     let (cv, cw) = match (req, opts.lb1_requirement) {
         (Requirement::Mi, _) => (0.0, 0.0),
         (Requirement::LbI { nu }, Lb1Requirement::Split) => split_down(b0, nu),

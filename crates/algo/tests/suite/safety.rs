@@ -440,3 +440,25 @@ fn certified_accounting_keeps_every_requirement_with_exact_gradients() {
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// LB-I's certified surplus starts at 0 whatever the initial budget (its requirement is
+/// J ≥ J(θ⁰), Table 4.1): with B⁰ = 5 the first v-step may lose nothing, and the logged surplus
+/// after it is the step's guarantee alone; LB-II with the same B⁰ may lose up to 5.
+#[test]
+fn lb1_surplus_ignores_the_initial_budget() {
+    let cfg = |req| SepgConfig {
+        gradient: GradientMode::Exact,
+        sigma0: vec![SIGMA0],
+        initial_budget: 5.0,
+        ..SepgConfig::new(
+            AnyEnv::Lqg(Box::new(LqgEnv::thesis())),
+            Algorithm::Sepg(req),
+        )
+    };
+    let (lb1, _) = run(cfg(Requirement::LbI { nu: 0.5 }), 1);
+    assert_eq!(lb1[0].required_v, Some(-0.0));
+    let g = lb1[0].guaranteed_v.unwrap_or(0.0) + lb1[0].guaranteed_w.unwrap_or(0.0);
+    assert!(lb1[0].budget <= g && lb1[0].budget < 1.0, "{:?}", lb1[0]);
+    let (lb2, _) = run(cfg(Requirement::LbII), 1);
+    assert_eq!(lb2[0].required_v, Some(-5.0));
+}
