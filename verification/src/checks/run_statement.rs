@@ -600,16 +600,7 @@ const PRESETS: [Preset; 2] = [Preset::Lqg, Preset::Lqg1d];
 fn theorem_r(ctx: &CheckContext<'_>) -> Evaluation {
     let (seeds, iterations) = if ctx.quick { QUICK } else { FULL };
     let cells = cells(&PRESETS, &VARIANTS, ctx.quick);
-    match run_cells(ctx, &cells, SepgOptions::default(), seeds, iterations) {
-        Some(results) => evaluate(&results, seeds, iterations),
-        None => Evaluation {
-            outcome: Outcome::Inconclusive {
-                reason: "a run or the oracle failed".into(),
-            },
-            cases: 0,
-            figures: Vec::new(),
-        },
-    }
+    judged_cells(ctx, &cells, SepgOptions::default(), seeds, iterations)
 }
 
 fn estimated_control(ctx: &CheckContext<'_>) -> Evaluation {
@@ -619,7 +610,19 @@ fn estimated_control(ctx: &CheckContext<'_>) -> Evaluation {
         CONTROL_FULL
     };
     let cells = cells(&PRESETS, &CONTROL_VARIANTS, true);
-    match run_cells(ctx, &cells, SepgOptions::estimated(), seeds, iterations) {
+    judged_cells(ctx, &cells, SepgOptions::estimated(), seeds, iterations)
+}
+
+/// The runs of `cells` with `options`, judged and evaluated; inconclusive when a run or the
+/// oracle fails.
+fn judged_cells(
+    ctx: &CheckContext<'_>,
+    cells: &[Cell],
+    options: SepgOptions,
+    seeds: u64,
+    iterations: u64,
+) -> Evaluation {
+    match run_cells(ctx, cells, options, seeds, iterations) {
         Some(results) => evaluate(&results, seeds, iterations),
         None => Evaluation {
             outcome: Outcome::Inconclusive {
