@@ -1,6 +1,7 @@
 //! Task constants and the penalty coefficients `c` (Theorems 3.14 / 4.2) and `d` (Theorem 4.3).
 
 use crate::error::{BoundsError, finite, no_overflow, positive};
+use crate::penalties::{Family, Horizon, Rewards, Tight};
 
 /// √(2π).
 const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
@@ -13,7 +14,9 @@ const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
 /// - `gamma`: discount factor γ ∈ [0, 1);
 /// - `r_max`: R, the largest absolute reward, R > 0;
 /// - `m_phi`: M_φ, the bound on every feature, |φ_i(s)| ≤ M_φ (eq. (3.14)), M_φ > 0;
-/// - `action_volume`: |A|, the volume of the action space, |A| > 0.
+/// - `action_volume`: |A|, the volume of the action space, |A| > 0;
+/// - the [`Family`] of the penalty coefficients c and d (the thesis's unless
+///   [`TaskConstants::with_family`] chose another).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskConstants {
     gamma: f64,
@@ -21,6 +24,10 @@ pub struct TaskConstants {
     m_phi: f64,
     action_volume: f64,
     psi: Option<f64>,
+    family: Family,
+    /// S_H of the tight family (docs/THEOREMS.md "Tight constants"), computed once; 0 for
+    /// the thesis family, which does not use it.
+    s_h: f64,
 }
 
 impl TaskConstants {
@@ -60,12 +67,56 @@ impl TaskConstants {
             m_phi,
             action_volume,
             psi: None,
+            family: Family::Thesis,
+            s_h: 0.0,
         })
+    }
+
+    /// The same constants with the penalty coefficients c and d of `family`: every bound that
+    /// takes these constants then uses that family's c, d and ∂c/∂σ.
+    ///
+    /// For [`Family::Tight`] the horizon's S_H = Σ_{t<H} (t + 1) γᵗ ([`s_h`]) is computed
+    /// here, once.
+    ///
+    /// Errors: a finite horizon of 0 steps.
+    ///
+    /// ```
+    /// use sepg_bounds::constants::{TaskConstants, c, d};
+    /// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+    /// let k = TaskConstants::new(0.99, 28.8, 4.0, 8.0)?;
+    /// let tight = Tight::new(Horizon::Finite(20), Rewards::NonPositive);
+    /// let t = k.with_family(Family::Tight(tight))?;
+    /// assert_eq!(t.family(), Family::Tight(tight));
+    /// assert!(c(&t, 1.0)? * 5000.0 < c(&k, 1.0)?);
+    /// assert!(d(&t, 1.0)? * 5000.0 < d(&k, 1.0)?);
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn with_family(self, family: Family) -> Result<Self, BoundsError> {
+        let s_h = match family {
+            Family::Thesis => 0.0,
+            Family::Tight(t) => s_h(self.gamma, t.horizon())?,
+        };
+        Ok(Self {
+            family,
+            s_h,
+            ..self
+        })
+    }
+
+    /// The family of the penalty coefficients ([`TaskConstants::with_family`]).
+    pub fn family(&self) -> Family {
+        self.family
+    }
+
+    /// S_H of the tight family as computed once by [`TaskConstants::with_family`]
+    /// ([`s_h`]); 0 for the thesis family, which does not use it.
+    pub fn horizon_weight(&self) -> f64 {
+        self.s_h
     }
 
     /// The same constants with ψ of Lemma A.1 replaced by `psi` in d (Theorem 4.3) and every
     /// bound built on it (the thesis-era public code used ψ = 0.53). The bounds stay valid for
-    /// any `psi` ≥ [`psi()`]; a smaller value voids them.
+    /// any `psi` ≥ [`psi()`]; a smaller value voids them. Only the thesis family uses ψ.
     ///
     /// Errors: `psi` not finite and strictly positive.
     ///
@@ -175,8 +226,12 @@ pub fn psi() -> f64 {
 /// # Formula
 ///
 /// ```text
-/// c(σ) = R M_φ² / ((1 − γ)² σ²) · ( |A| / (√(2π) σ) + γ / (2 (1 − γ)) )
+/// c(σ) = R M_φ² / ((1 − γ)² σ²) · ( |A| / (√(2π) σ) + γ / (2 (1 − γ)) )   thesis family
+/// c(σ) = ρ R M_φ² S_H / σ²                                                tight family
 /// ```
+///
+/// where, for the tight family (docs/THEOREMS.md "Tight constants"), S_H is [`s_h`] and
+/// ρ = 1 for rewards of either sign, ρ = 1/2 for non-positive rewards.
 ///
 /// Domain: σ > 0 (standard deviation of the Gaussian policy, action units). Units of
 /// R / (action)², so that c‖Δv‖² is a performance. Strictly decreasing in σ.
@@ -200,6 +255,9 @@ pub fn c(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 /// c(σ) of [`c`] for a validated σ, unchecked for overflow.
 #[inline]
 pub(crate) fn c_value(k: &TaskConstants, sigma: f64) -> f64 {
+    if let Family::Tight(t) = k.family {
+        return t.rewards().factor() * k.r_max * k.m_phi * k.m_phi * k.s_h / (sigma * sigma);
+    }
     let g = k.gamma;
     let one_minus = 1.0 - g;
     let front = k.r_max * k.m_phi * k.m_phi / (one_minus * one_minus);
@@ -213,7 +271,8 @@ pub(crate) fn c_value(k: &TaskConstants, sigma: f64) -> f64 {
 /// # Formula
 ///
 /// ```text
-/// ∂c/∂σ = R M_φ² / (1 − γ)² · ( −3 |A| / (√(2π) σ⁴) − γ / ((1 − γ) σ³) )
+/// ∂c/∂σ = R M_φ² / (1 − γ)² · ( −3 |A| / (√(2π) σ⁴) − γ / ((1 − γ) σ³) )   thesis family
+/// ∂c/∂σ = −2 c(σ) / σ                                                    tight family
 /// ```
 ///
 /// Domain: σ > 0. Always strictly negative.
@@ -228,6 +287,10 @@ pub(crate) fn c_value(k: &TaskConstants, sigma: f64) -> f64 {
 /// ```
 pub fn dc_dsigma(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     positive("sigma", sigma)?;
+    if let Family::Tight(_) = k.family {
+        // c = K/σ² ⇒ ∂c/∂σ = −2K/σ³ = −2c/σ
+        return no_overflow("dc/dsigma", -2.0 * (c_value(k, sigma) / sigma));
+    }
     let g = k.gamma;
     let one_minus = 1.0 - g;
     let front = k.r_max * k.m_phi * k.m_phi / (one_minus * one_minus);
@@ -247,7 +310,10 @@ fn psi_of(k: &TaskConstants) -> f64 {
 ///
 /// ```text
 /// d(σ) = R / (1 − γ)² · ( ψ |A| / (2σ) + γ / (1 − γ) ),   ψ = psi() unless overridden
+/// d    = 2 ρ R S_H                                         tight family, every σ
 /// ```
+///
+/// (ρ and S_H as in [`c`].)
 ///
 /// Domain: σ > 0 is the standard deviation *before* the w-update (σ = e^w). Units of R per
 /// (log-σ)², so that dΔw² is a performance. Strictly decreasing in σ.
@@ -267,6 +333,9 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
 /// d(σ) of [`d`] for a validated σ, unchecked for overflow.
 #[inline]
 pub(crate) fn d_value(k: &TaskConstants, sigma: f64) -> f64 {
+    if let Family::Tight(t) = k.family {
+        return t.rewards().factor() * 2.0 * k.r_max * k.s_h;
+    }
     let one_minus = 1.0 - k.gamma;
     let front = k.r_max / (one_minus * one_minus);
     let bracket = psi_of(k) * k.action_volume / (2.0 * sigma) + k.gamma / one_minus;
@@ -275,11 +344,105 @@ pub(crate) fn d_value(k: &TaskConstants, sigma: f64) -> f64 {
 
 /// The two coefficients of the rigorous w-bound (module [`crate::rigorous`]):
 /// `(a, g)` with a = R ψ |A| / (2 (1 − γ)² σ) and g = γ R / (2 (1 − γ)³), so that
-/// d(σ) = a + 2g.
+/// d(σ) = a + 2g. Thesis family only: the tight family's d needs no rigorous form.
 pub(crate) fn d_parts(k: &TaskConstants, sigma: f64) -> Result<(f64, f64), BoundsError> {
     positive("sigma", sigma)?;
     let one_minus = 1.0 - k.gamma;
     let a = k.r_max * psi_of(k) * k.action_volume / (2.0 * one_minus * one_minus * sigma);
     let g = k.gamma * k.r_max / (2.0 * one_minus * one_minus * one_minus);
     Ok((no_overflow("d", a)?, no_overflow("d", g)?))
+}
+
+/// S_H = Σ_{t<H} (t + 1) γᵗ, the horizon's weight in the tight constants (docs/THEOREMS.md
+/// "Tight constants"): the discounted sum of the number of score terms each reward is
+/// multiplied by.
+///
+/// # Formula
+///
+/// ```text
+/// S_H = Σ_{t=0}^{H−1} (t + 1) γᵗ = (1 − (H + 1) γ^H + H γ^{H+1}) / (1 − γ)²,   S_∞ = 1 / (1 − γ)²
+/// ```
+///
+/// Evaluated by Horner's rule for H ≤ 2²⁰ (positive terms, two roundings each: relative error
+/// at most 2Hu/(1 − 2Hu), u = 2⁻⁵³), and beyond by the closed form with `exp_m1` and `ln_1p`,
+/// clamped to [1, S_∞]. Dimensionless,
+/// in [1, 1/(1 − γ)²]; S_H = H(H + 1)/2 when γ = 1 is excluded by γ < 1.
+///
+/// Errors: γ not in [0, 1); a finite horizon of 0 steps.
+///
+/// ```
+/// use sepg_bounds::constants::s_h;
+/// use sepg_bounds::penalties::Horizon;
+/// assert_eq!(s_h(0.5, Horizon::Finite(1))?, 1.0);
+/// assert_eq!(s_h(0.5, Horizon::Finite(2))?, 2.0); // 1 + 2·0.5
+/// assert_eq!(s_h(0.5, Horizon::Infinite)?, 4.0);
+/// let closed = (1.0 - 21.0 * 0.99f64.powi(20) + 20.0 * 0.99f64.powi(21)) / (0.01f64 * 0.01);
+/// assert!((s_h(0.99, Horizon::Finite(20))? - closed).abs() < 1e-11 * closed);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn s_h(gamma: f64, horizon: Horizon) -> Result<f64, BoundsError> {
+    finite("gamma", gamma)?;
+    if !(0.0..1.0).contains(&gamma) {
+        return Err(BoundsError::OutOfDomain {
+            name: "gamma",
+            value: gamma,
+            domain: "[0, 1)",
+        });
+    }
+    let one_minus = 1.0 - gamma;
+    let infinite = 1.0 / (one_minus * one_minus);
+    let h = match horizon {
+        Horizon::Infinite => return Ok(infinite),
+        Horizon::Finite(0) => {
+            return Err(BoundsError::OutOfDomain {
+                name: "horizon",
+                value: 0.0,
+                domain: "{1, 2, ...} or infinite",
+            });
+        }
+        Horizon::Finite(h) => h,
+    };
+    if h <= HORNER_LIMIT {
+        // Σ_{t<H} (t + 1) γᵗ = 1 + γ(2 + γ(3 + … + γ·H))
+        let mut acc = h as f64;
+        for t in (0..h - 1).rev() {
+            acc = (t + 1) as f64 + gamma * acc;
+        }
+        return Ok(acc);
+    }
+    // 1 − (H + 1)γ^H + Hγ^{H+1} = 1 − γ^H (1 + H(1 − γ)) = −expm1(H ln γ + ln(1 + H(1 − γ)))
+    let hf = h as f64;
+    let exponent = hf * gamma.ln() + (hf * one_minus).ln_1p();
+    let value = -exponent.exp_m1() / (one_minus * one_minus);
+    Ok(value.clamp(1.0, infinite))
+}
+
+/// The largest horizon [`s_h`] sums term by term.
+const HORNER_LIMIT: u64 = 1 << 20;
+
+impl Rewards {
+    /// ρ of the tight constants: 1 for rewards of either sign, 1/2 for non-positive rewards.
+    pub(crate) fn factor(self) -> f64 {
+        match self {
+            Rewards::TwoSided => 1.0,
+            Rewards::NonPositive => 0.5,
+        }
+    }
+}
+
+impl Tight {
+    /// The tight family for a horizon and a reward sign.
+    pub const fn new(horizon: Horizon, rewards: Rewards) -> Self {
+        Self { horizon, rewards }
+    }
+
+    /// The horizon H the constants hold for.
+    pub fn horizon(self) -> Horizon {
+        self.horizon
+    }
+
+    /// What is known of the rewards' sign.
+    pub fn rewards(self) -> Rewards {
+        self.rewards
+    }
 }

@@ -70,7 +70,7 @@ impl ExploringBound {
         Ok(ExploringBound {
             grad_w_j_hat: finite("grad_w_j_hat", grad_w_j_hat)?,
             eps_j: non_negative("eps_j", eps_j)?,
-            d: Penalties::thesis(k, sigma)?.d()?,
+            d: Penalties::new(k, sigma)?.d()?,
         })
     }
 

@@ -113,7 +113,7 @@ impl HighProbabilityBound {
         grad_v_hat: &[f64],
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::v_update_at(&Penalties::thesis(k, sigma)?, grad_v_hat, eps)
+        Self::v_update_at(&Penalties::new(k, sigma)?, grad_v_hat, eps)
     }
 
     /// [`Self::v_update`] for penalties evaluated once ([`Penalties`]), with c = `p.c()`.
@@ -151,7 +151,7 @@ impl HighProbabilityBound {
         grad_w_j_hat: f64,
         eps: f64,
     ) -> Result<Option<Self>, BoundsError> {
-        Self::w_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j_hat, eps)
+        Self::w_along_j_at(&Penalties::new(k, sigma)?, grad_w_j_hat, eps)
     }
 
     /// [`Self::w_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
@@ -196,7 +196,7 @@ impl HighProbabilityBound {
         eps_l: f64,
     ) -> Result<Option<Self>, BoundsError> {
         Self::w_along_l_at(
-            &Penalties::thesis(k, sigma)?,
+            &Penalties::new(k, sigma)?,
             grad_w_j_hat,
             eps_j,
             grad_w_l_hat,

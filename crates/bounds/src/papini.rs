@@ -33,7 +33,7 @@ pub fn bound(
     finite_vector("grad", grad)?;
     finite_vector("steps", steps)?;
     same_length("grad", grad, "steps", steps)?;
-    bound_at(&Penalties::thesis(k, sigma)?, grad, steps)
+    bound_at(&Penalties::new(k, sigma)?, grad, steps)
 }
 
 /// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -80,7 +80,7 @@ pub struct GreedyStep {
 /// ```
 pub fn greedy_step(k: &TaskConstants, sigma: f64, grad: &[f64]) -> Result<GreedyStep, BoundsError> {
     argmax_abs(grad)?;
-    greedy_step_at(&Penalties::thesis(k, sigma)?, grad)
+    greedy_step_at(&Penalties::new(k, sigma)?, grad)
 }
 
 /// [`greedy_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their

@@ -8,9 +8,10 @@
 //! [`crate::high_probability::HighProbabilityBound::v_update_at`], ...) neither re-validate σ
 //! nor recompute c or d.
 //!
-//! The [`Family`] says which formulas give c and d. Only the thesis family exists today;
-//! another family adds a variant here and its formulas in [`Penalties::c`] and
-//! [`Penalties::d`], and every bound built on a [`Penalties`] follows.
+//! The [`Family`] says which formulas give c and d: the thesis's (Theorems 3.14, 4.2, 4.3) or
+//! the tight constants (docs/THEOREMS.md "Tight constants"). The family is part of the
+//! [`TaskConstants`] ([`TaskConstants::with_family`]), so every bound that takes the
+//! constants, with or without a [`Penalties`], follows it.
 
 use std::cell::Cell;
 
@@ -26,6 +27,37 @@ pub enum Family {
     /// [`TaskConstants::with_psi`] replaced it.
     #[default]
     Thesis,
+    /// The tight constants c = ρ R M_φ² S_H / σ² and d = 2ρ R S_H of docs/THEOREMS.md
+    /// "Tight constants" (Theorem T), from the likelihood-ratio form of the Hessian of J:
+    /// valid on ℝ (no action volume enters), for every σ and, for d, for every change of σ.
+    Tight(Tight),
+}
+
+/// What the tight constants need to know of the task beyond R, M_φ and γ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Tight {
+    pub(crate) horizon: Horizon,
+    pub(crate) rewards: Rewards,
+}
+
+/// The horizon H of J_H = E Σ_{t<H} γᵗ r_t.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Horizon {
+    /// H steps (H ≥ 1); an episode that terminates earlier has reward 0 afterwards.
+    Finite(u64),
+    /// H = ∞ (γ < 1).
+    Infinite,
+}
+
+/// What is known of the sign of every reward r_t (|r_t| ≤ R always).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Rewards {
+    /// Rewards of either sign: the two-sided constants (ρ = 1). Always sound.
+    TwoSided,
+    /// −R ≤ r_t ≤ 0 for every t: the curvature of log π is then of the favourable sign and
+    /// the constants halve (ρ = 1/2). A task with rewards in [lo, hi], a fixed horizon and no
+    /// termination can be shifted by −hi to qualify, with R = hi − lo.
+    NonPositive,
 }
 
 /// The penalty coefficients of a task at one standard deviation σ, for one [`Family`]:
@@ -35,48 +67,34 @@ pub enum Family {
 /// use sepg_bounds::constants::{self, TaskConstants};
 /// use sepg_bounds::penalties::{Family, Penalties};
 /// let k = TaskConstants::new(0.99, 4.0, 2.0, 4.0)?;
-/// let p = Penalties::new(&k, Family::Thesis, 0.5)?;
+/// let p = Penalties::new(&k, 0.5)?;
+/// assert_eq!(p.family(), Family::Thesis);
 /// assert_eq!(p.c()?, constants::c(&k, 0.5)?);
 /// assert_eq!(p.d()?, constants::d(&k, 0.5)?);
-/// assert!(Penalties::new(&k, Family::Thesis, 0.0).is_err());
+/// assert!(Penalties::new(&k, 0.0).is_err());
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Penalties {
     task: TaskConstants,
-    family: Family,
     sigma: f64,
     c: Cell<Option<f64>>,
     d: Cell<Option<f64>>,
 }
 
 impl Penalties {
-    /// The coefficients of `family` for the task `k` at standard deviation `sigma` (action
-    /// units).
+    /// The coefficients of the family of `k` ([`TaskConstants::family`]) at standard
+    /// deviation `sigma` (action units).
     ///
     /// Errors: σ not finite and strictly positive (the error of [`crate::constants::c`]).
     #[inline]
-    pub fn new(k: &TaskConstants, family: Family, sigma: f64) -> Result<Self, BoundsError> {
+    pub fn new(k: &TaskConstants, sigma: f64) -> Result<Self, BoundsError> {
         Ok(Self {
             task: *k,
-            family,
             sigma: positive("sigma", sigma)?,
             c: Cell::new(None),
             d: Cell::new(None),
         })
-    }
-
-    /// [`Penalties::new`] for the thesis family.
-    ///
-    /// ```
-    /// use sepg_bounds::{constants::TaskConstants, penalties::{Family, Penalties}};
-    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
-    /// assert_eq!(Penalties::thesis(&k, 1.0)?.family(), Family::Thesis);
-    /// # Ok::<(), sepg_bounds::BoundsError>(())
-    /// ```
-    #[inline]
-    pub fn thesis(k: &TaskConstants, sigma: f64) -> Result<Self, BoundsError> {
-        Self::new(k, Family::Thesis, sigma)
     }
 
     /// The task constants.
@@ -84,9 +102,9 @@ impl Penalties {
         &self.task
     }
 
-    /// The family of the coefficients.
+    /// The family of the coefficients, that of the task constants.
     pub fn family(&self) -> Family {
-        self.family
+        self.task.family()
     }
 
     /// σ > 0, the standard deviation the coefficients are evaluated at.
@@ -102,9 +120,7 @@ impl Penalties {
         let value = match self.c.get() {
             Some(value) => value,
             None => {
-                let value = match self.family {
-                    Family::Thesis => c_value(&self.task, self.sigma),
-                };
+                let value = c_value(&self.task, self.sigma);
                 self.c.set(Some(value));
                 value
             }
@@ -120,9 +136,7 @@ impl Penalties {
         let value = match self.d.get() {
             Some(value) => value,
             None => {
-                let value = match self.family {
-                    Family::Thesis => d_value(&self.task, self.sigma),
-                };
+                let value = d_value(&self.task, self.sigma);
                 self.d.set(Some(value));
                 value
             }

@@ -67,7 +67,7 @@ fn squared_norms(x: &[f64]) -> Result<(f64, f64), BoundsError> {
 pub fn bound(k: &TaskConstants, sigma: f64, grad: &[f64], alpha: f64) -> Result<f64, BoundsError> {
     finite_vector("grad", grad)?;
     finite("alpha", alpha)?;
-    bound_at(&Penalties::thesis(k, sigma)?, grad, alpha)
+    bound_at(&Penalties::new(k, sigma)?, grad, alpha)
 }
 
 /// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -109,7 +109,7 @@ pub fn optimal_step(
     grad: &[f64],
 ) -> Result<AdaptiveStep, BoundsError> {
     finite_vector("grad", grad)?;
-    optimal_step_at(&Penalties::thesis(k, sigma)?, grad)
+    optimal_step_at(&Penalties::new(k, sigma)?, grad)
 }
 
 /// [`optimal_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -186,7 +186,7 @@ pub fn hp_bound(
 ) -> Result<f64, BoundsError> {
     finite("alpha", alpha)?;
     corrected(grad_hat, eps)?;
-    hp_bound_at(&Penalties::thesis(k, sigma)?, grad_hat, eps, alpha)
+    hp_bound_at(&Penalties::new(k, sigma)?, grad_hat, eps, alpha)
 }
 
 /// [`hp_bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -236,7 +236,7 @@ pub fn hp_optimal_step(
     eps: &[f64],
 ) -> Result<AdaptiveStep, BoundsError> {
     corrected(grad_hat, eps)?;
-    hp_optimal_step_at(&Penalties::thesis(k, sigma)?, grad_hat, eps)
+    hp_optimal_step_at(&Penalties::new(k, sigma)?, grad_hat, eps)
 }
 
 /// [`hp_optimal_step`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their

@@ -56,6 +56,7 @@
 use crate::constants::{TaskConstants, d, d_parts};
 use crate::error::{BoundsError, finite, finite_vector, no_overflow, positive};
 use crate::outcome::{SafeInterval, StepOutcome};
+use crate::penalties::Family;
 
 /// √(2π).
 const SQRT_2PI: f64 = 2.506_628_274_631_000_7;
@@ -116,8 +117,9 @@ pub fn k_mu() -> f64 {
 /// c_ℝ(σ) = R M_φ² / ((1 − γ)² σ²) · ( max(|A| / (√(2π) σ), K_MU) + γ / (2 (1 − γ)) )
 /// ```
 ///
-/// Equal to the thesis's c for σ ≤ |A| e^{1/2} / 4 (1.649 for |A| = 4), larger above. Domain
-/// σ > 0; units as c.
+/// Equal to the thesis's c for σ ≤ |A| e^{1/2} / 4 (1.649 for |A| = 4), larger above. For the
+/// tight family ([`crate::penalties::Family::Tight`]), whose c holds on ℝ, it is that c.
+/// Domain σ > 0; units as c.
 ///
 /// Errors: σ not finite and positive; overflow.
 ///
@@ -130,6 +132,10 @@ pub fn k_mu() -> f64 {
 /// ```
 pub fn c(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
     positive("sigma", sigma)?;
+    if let Family::Tight(_) = k.family() {
+        // the tight family's c is proven on ℝ (docs/THEOREMS.md "Tight constants")
+        return crate::constants::c(k, sigma);
+    }
     if k.action_volume() / (SQRT_2PI * sigma) >= k_mu() {
         // the box term is the larger: the thesis's c, bit for bit
         return crate::constants::c(k, sigma);
@@ -250,6 +256,17 @@ fn a_line(k: &TaskConstants) -> Result<f64, BoundsError> {
     )
 }
 
+/// (a, a_ℝ, G) of the module docs. The tight family's d holds for every Δw and every σ
+/// (docs/THEOREMS.md "Tight constants"), so its rigorous bound is Δw ∇_w J − d Δw²:
+/// a = 0, a_ℝ = d, G = 0.
+fn parts(k: &TaskConstants, sigma: f64) -> Result<(f64, f64, f64), BoundsError> {
+    if let Family::Tight(_) = k.family() {
+        return Ok((0.0, d(k, sigma)?, 0.0));
+    }
+    let (a, g) = d_parts(k, sigma)?;
+    Ok((a, a_line(k)?, g))
+}
+
 /// The validated coefficients of the rigorous bound.
 #[derive(Debug, Clone, Copy)]
 struct Rigorous {
@@ -263,10 +280,10 @@ struct Rigorous {
 
 impl Rigorous {
     fn new(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<Self, BoundsError> {
-        let (a, g) = d_parts(k, sigma)?;
+        let (a, a_line, g) = parts(k, sigma)?;
         Ok(Self {
             a,
-            a_line: a_line(k)?,
+            a_line,
             g,
             slope: finite("grad_w_j", grad_w_j)?,
         })
@@ -457,6 +474,11 @@ pub fn thesis_bound(
 /// ```
 pub fn gap(k: &TaskConstants, sigma: f64, delta_w: f64) -> Result<f64, BoundsError> {
     finite("delta_w", delta_w)?;
+    if let Family::Tight(_) = k.family() {
+        // the thesis form with the tight d is itself rigorous: the two bounds coincide
+        positive("sigma", sigma)?;
+        return Ok(0.0);
+    }
     let (a, g) = d_parts(k, sigma)?;
     let a_line = a_line(k)?;
     let x2 = delta_w * delta_w;

@@ -24,7 +24,7 @@ use crate::penalties::Penalties;
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn alpha_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    alpha_star_at(&Penalties::thesis(k, sigma)?)
+    alpha_star_at(&Penalties::new(k, sigma)?)
 }
 
 /// [`alpha_star`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -52,7 +52,7 @@ pub fn c_max(k: &TaskConstants, sigma: f64, grad_v: &[f64]) -> Result<f64, Bound
     finite_vector("grad_v", grad_v)?;
     let n = inf_norm(grad_v);
     no_overflow("||grad_v||^2", n * n)?;
-    c_max_at(&Penalties::thesis(k, sigma)?, grad_v)
+    c_max_at(&Penalties::new(k, sigma)?, grad_v)
 }
 
 /// [`c_max`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -91,7 +91,7 @@ pub fn bound(
 ) -> Result<f64, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("alpha", alpha)?;
-    bound_at(&Penalties::thesis(k, sigma)?, grad_v, alpha)
+    bound_at(&Penalties::new(k, sigma)?, grad_v, alpha)
 }
 
 /// [`bound`] for penalties evaluated once ([`Penalties`]), with c = `p.c()` of their
@@ -150,7 +150,7 @@ pub fn safe_step(
 ) -> Result<StepOutcome, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    parabola(Penalties::thesis(k, sigma)?.c()?, inf_norm(grad_v))?.solve(required)
+    parabola(Penalties::new(k, sigma)?.c()?, inf_norm(grad_v))?.solve(required)
 }
 
 /// [`safe_step`] for penalties evaluated once ([`Penalties`]): the safe steps of eq. (4.10)
@@ -159,7 +159,7 @@ pub fn safe_step(
 /// ```
 /// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, v_update};
 /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
-/// let p = Penalties::thesis(&k, 1.0)?;
+/// let p = Penalties::new(&k, 1.0)?;
 /// assert_eq!(v_update::safe_step_at(&p, &[0.5], 0.0)?, v_update::safe_step(&k, 1.0, &[0.5], 0.0)?);
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```

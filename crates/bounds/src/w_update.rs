@@ -26,7 +26,7 @@ use crate::penalties::Penalties;
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn beta_star(k: &TaskConstants, sigma: f64) -> Result<f64, BoundsError> {
-    beta_star_at(&Penalties::thesis(k, sigma)?)
+    beta_star_at(&Penalties::new(k, sigma)?)
 }
 
 /// [`beta_star`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
@@ -52,7 +52,7 @@ pub fn beta_star_at(p: &Penalties) -> Result<f64, BoundsError> {
 pub fn c_max(k: &TaskConstants, sigma: f64, grad_w_j: f64) -> Result<f64, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    c_max_at(&Penalties::thesis(k, sigma)?, grad_w_j)
+    c_max_at(&Penalties::new(k, sigma)?, grad_w_j)
 }
 
 /// [`c_max`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
@@ -87,7 +87,7 @@ pub fn bound_along_j(
     finite("grad_w_j", grad_w_j)?;
     finite("beta", beta)?;
     no_overflow("(grad_w_j)^2", grad_w_j * grad_w_j)?;
-    bound_along_j_at(&Penalties::thesis(k, sigma)?, grad_w_j, beta)
+    bound_along_j_at(&Penalties::new(k, sigma)?, grad_w_j, beta)
 }
 
 /// [`bound_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
@@ -126,7 +126,7 @@ pub fn safe_step_along_j(
 ) -> Result<StepOutcome, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
-    parabola_along_j(Penalties::thesis(k, sigma)?.d()?, grad_w_j)?.solve(required)
+    parabola_along_j(Penalties::new(k, sigma)?.d()?, grad_w_j)?.solve(required)
 }
 
 /// [`safe_step_along_j`] for penalties evaluated once ([`Penalties`]), with d = `p.d()`.
@@ -134,7 +134,7 @@ pub fn safe_step_along_j(
 /// ```
 /// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, w_update};
 /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
-/// let p = Penalties::thesis(&k, 1.0)?;
+/// let p = Penalties::new(&k, 1.0)?;
 /// let expected = w_update::safe_step_along_j(&k, 1.0, 0.3, 0.0)?;
 /// assert_eq!(w_update::safe_step_along_j_at(&p, 0.3, 0.0)?, expected);
 /// # Ok::<(), sepg_bounds::BoundsError>(())
@@ -198,7 +198,7 @@ pub fn bound_along_l(
     finite("beta", beta)?;
     no_overflow("grad_w_l * grad_w_j", grad_w_l * grad_w_j)?;
     no_overflow("(grad_w_l)^2", grad_w_l * grad_w_l)?;
-    bound_along_l_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l, beta)
+    bound_along_l_at(&Penalties::new(k, sigma)?, grad_w_j, grad_w_l, beta)
 }
 
 /// [`bound_along_l`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
@@ -249,7 +249,7 @@ pub fn beta_tilde(
             domain: "non-zero reals",
         });
     }
-    beta_tilde_at(&Penalties::thesis(k, sigma)?, grad_w_j, grad_w_l)
+    beta_tilde_at(&Penalties::new(k, sigma)?, grad_w_j, grad_w_l)
 }
 
 /// [`beta_tilde`] for penalties evaluated once ([`Penalties`]), with d = `p.d()` of their
@@ -299,7 +299,7 @@ pub fn safe_step_along_l(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
-    let d = Penalties::thesis(k, sigma)?.d()?;
+    let d = Penalties::new(k, sigma)?.d()?;
     parabola_along_l(d, grad_w_j, grad_w_l)?.solve(required)
 }
 
@@ -308,7 +308,7 @@ pub fn safe_step_along_l(
 /// ```
 /// use sepg_bounds::{constants::TaskConstants, penalties::Penalties, w_update};
 /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
-/// let p = Penalties::thesis(&k, 1.0)?;
+/// let p = Penalties::new(&k, 1.0)?;
 /// let expected = w_update::safe_step_along_l(&k, 1.0, 0.3, -2.0, -0.1)?;
 /// assert_eq!(w_update::safe_step_along_l_at(&p, 0.3, -2.0, -0.1)?, expected);
 /// # Ok::<(), sepg_bounds::BoundsError>(())

@@ -4,6 +4,7 @@
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::error::{BoundsError, finite, finite_vector, inf_norm, non_negative, positive};
 use sepg_bounds::high_probability::HpForm;
+use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use sepg_bounds::rigorous;
 
 use crate::interval::Interval;
@@ -48,7 +49,35 @@ fn one_minus_gamma(k: &TaskConstants) -> Interval {
     Interval::point(1.0) - Interval::point(k.gamma())
 }
 
-/// An enclosure of c(σ) of Theorems 3.14 / 4.2 (see [`sepg_bounds::constants::c`]).
+/// S_H of the tight constants ([`sepg_bounds::constants::s_h`]), enclosed.
+///
+/// For H ≤ 2²⁰ the `f64` value kept by the task constants is Horner's sum of H positive terms
+/// with two roundings each, so Ŝ = S_H (1 + θ) with |θ| ≤ γ_{2H} = 2Hu/(1 − 2Hu), and
+/// |S_H − Ŝ| ≤ 4Hu·Ŝ (2Hu ≤ 2⁻³²). Beyond, or for H = ∞, [1, 1/(1 − γ)²] (S_H increases
+/// to S_∞ = 1/(1 − γ)²; equality for H = ∞).
+fn s_h(k: &TaskConstants, tight: Tight) -> Interval {
+    let om = one_minus_gamma(k);
+    let infinite = Interval::point(1.0) / om.sqr();
+    match tight.horizon() {
+        Horizon::Infinite => infinite,
+        Horizon::Finite(h) if h <= 1 << 20 => {
+            let value = k.horizon_weight();
+            Interval::around(value, value * (4.0 * h as f64 * f64::EPSILON / 2.0))
+        }
+        Horizon::Finite(_) => Interval::point(1.0).hull(infinite),
+    }
+}
+
+/// ρ of the tight constants: 1, or 1/2 for non-positive rewards (exact in `f64`).
+fn rho(tight: Tight) -> f64 {
+    match tight.rewards() {
+        Rewards::NonPositive => 0.5,
+        Rewards::TwoSided => 1.0,
+    }
+}
+
+/// An enclosure of c(σ) of Theorems 3.14 / 4.2 (see [`sepg_bounds::constants::c`]), or of
+/// the tight family's c(σ) = ρ R M_φ² S_H / σ².
 ///
 /// # Formula
 ///
@@ -67,6 +96,13 @@ fn one_minus_gamma(k: &TaskConstants) -> Interval {
 /// ```
 pub fn c(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     positive("sigma", sigma)?;
+    if let Family::Tight(t) = k.family() {
+        let s = Interval::point(sigma);
+        return Ok(
+            (Interval::point(k.r_max()) * Interval::point(k.m_phi()).sqr() * s_h(k, t) / s.sqr())
+                .scale(rho(t)),
+        );
+    }
     let om = one_minus_gamma(k);
     let s = Interval::point(sigma);
     let front =
@@ -76,7 +112,8 @@ pub fn c(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     Ok(front * bracket)
 }
 
-/// An enclosure of d(σ) of Theorem 4.3 (see [`sepg_bounds::constants::d`]).
+/// An enclosure of d(σ) of Theorem 4.3 (see [`sepg_bounds::constants::d`]), or of the tight
+/// family's d = 2ρ R S_H.
 ///
 /// # Formula
 ///
@@ -95,6 +132,9 @@ pub fn c(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
 /// ```
 pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     positive("sigma", sigma)?;
+    if let Family::Tight(t) = k.family() {
+        return Ok((Interval::point(k.r_max()) * s_h(k, t)).scale(2.0 * rho(t)));
+    }
     let om = one_minus_gamma(k);
     let front = Interval::point(k.r_max()) / om.sqr();
     let bracket = psi_of(k) * Interval::point(k.action_volume())
@@ -444,6 +484,16 @@ impl RigorousEnclosure {
         direction: f64,
     ) -> Result<Self, BoundsError> {
         positive("sigma", sigma)?;
+        if let Family::Tight(_) = k.family() {
+            // the tight d holds for every Δw: f(Δw) = Δw ∇_wJ − d Δw² (a = 0, a_ℝ = d, G = 0)
+            return Ok(Self {
+                a: Interval::point(0.0),
+                a_line: d(k, sigma)?,
+                g: Interval::point(0.0),
+                slope: finite("grad_w_j", grad_w_j)?,
+                direction: finite("direction", direction)?,
+            });
+        }
         let om = one_minus_gamma(k);
         let r = Interval::point(k.r_max());
         let a = r * psi_of(k) * Interval::point(k.action_volume())

@@ -75,7 +75,8 @@ const UNDERFLOW_SLACK: f64 = 16.0 * f64::from_bits(1);
 const BOX_LO: f64 = 7.888_609_052_210_118e-31;
 const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
 
-/// Whether R, M_φ, |A| ∈ [2⁻¹⁰⁰, 2¹⁰⁰], γ = 0 or γ ≥ 2⁻¹⁰⁰, and the platform's ψ lies within
+/// Whether the constants are of the thesis family, R, M_φ, |A| ∈ [2⁻¹⁰⁰, 2¹⁰⁰], γ = 0 or
+/// γ ≥ 2⁻¹⁰⁰, and the platform's ψ lies within
 /// one ulp of its enclosure (the last condition only matters for d, holds wherever `exp` is
 /// accurate to an ulp, and is decided once per process): the range of the task constants that
 /// [`CertifiedTask`](crate::CertifiedTask) decides once.
@@ -83,7 +84,9 @@ const BOX_HI: f64 = 1.267_650_600_228_229_4e30;
 pub(crate) fn task_in_box(k: &TaskConstants) -> bool {
     let inside = |x: f64| (BOX_LO..=BOX_HI).contains(&x);
     let gamma = k.gamma();
-    inside(k.r_max())
+    // the a-priori counts are those of the thesis's formulas; the tight family is enclosed
+    matches!(k.family(), sepg_bounds::Family::Thesis)
+        && inside(k.r_max())
         && inside(k.m_phi())
         && inside(k.action_volume())
         && (gamma == 0.0 || gamma >= BOX_LO)

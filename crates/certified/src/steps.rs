@@ -108,7 +108,7 @@ fn v_safe_step_in(
 ) -> Result<Certified, BoundsError> {
     finite_vector("grad_v", grad_v)?;
     finite("required", required)?;
-    let cc = Penalties::thesis(k, sigma)?.c()?;
+    let cc = Penalties::new(k, sigma)?.c()?;
     let n = inf_norm(grad_v);
     let fast = move || squared_parabola(n, rounding::c(in_range, sigma, cc));
     let parabola = v_update::parabola(cc, n);
@@ -156,7 +156,7 @@ fn w_safe_step_along_j_in(
 ) -> Result<Certified, BoundsError> {
     finite("grad_w_j", grad_w_j)?;
     finite("required", required)?;
-    let dd = Penalties::thesis(k, sigma)?.d()?;
+    let dd = Penalties::new(k, sigma)?.d()?;
     let fast = move || squared_parabola(grad_w_j, rounding::d(in_range, sigma, dd));
     let parabola = w_update::parabola_along_j(dd, grad_w_j);
     certify_step(
@@ -208,7 +208,7 @@ fn w_safe_step_along_l_in(
     finite("grad_w_j", grad_w_j)?;
     finite("grad_w_l", grad_w_l)?;
     finite("required", required)?;
-    let dd = Penalties::thesis(k, sigma)?.d()?;
+    let dd = Penalties::new(k, sigma)?.d()?;
     let fast = move || {
         let (j, l) = (Rounded::exact(grad_w_j), Rounded::exact(grad_w_l));
         let b = rounding::d(in_range, sigma, dd)?.mul(l.mul(l)?)?;
@@ -264,7 +264,7 @@ fn hp_v_safe_step_in(
     form: HpForm,
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
-    let penalties = Penalties::thesis(k, sigma)?;
+    let penalties = Penalties::new(k, sigma)?;
     let cc = penalties.c()?;
     let bound = hp::HighProbabilityBound::v_update_at(&penalties, grad_v_hat, eps)?;
     let fast = move || {
@@ -321,7 +321,7 @@ fn hp_w_safe_step_along_j_in(
     form: HpForm,
 ) -> Result<Certified, BoundsError> {
     finite("required", required)?;
-    let penalties = Penalties::thesis(k, sigma)?;
+    let penalties = Penalties::new(k, sigma)?;
     let dd = penalties.d()?;
     let bound = hp::HighProbabilityBound::w_along_j_at(&penalties, grad_w_j_hat, eps)?;
     let fast = move || {
@@ -381,7 +381,7 @@ fn hp_w_safe_step_along_l_in(
     let (j, ej) = grad_w_j_hat;
     let (l, el) = grad_w_l_hat;
     finite("required", required)?;
-    let penalties = Penalties::thesis(k, sigma)?;
+    let penalties = Penalties::new(k, sigma)?;
     let dd = penalties.d()?;
     let bound = hp::HighProbabilityBound::w_along_l_at(&penalties, j, ej, l, el)?;
     let fast = move || {

@@ -18,7 +18,9 @@
 //! for exact gradients). On the confidence event |∂J − ĝ| ≤ ε both hold for every Δ at once;
 //! c_ℝ is c of Theorem 4.2 with the box term made sound on ℝ (`sepg_bounds::rigorous::c`),
 //! and the log-σ bound is the rigorous form of Theorem 4.3 (`sepg_bounds::rigorous::bound`,
-//! sound for every σ and both signs of Δ). The first bound dominates Theorem 4.7's (with
+//! sound for every σ and both signs of Δ). With the tight constants (docs/THEOREMS.md
+//! "Tight constants") c_ℝ = c and the log-σ bound is Δ·ĝ − |Δ|·ε − d·Δ²: both are proven on
+//! ℝ for every Δ. The first bound dominates Theorem 4.7's (with
 //! Δ = α ĝ_k, αĝ_k² − α|ĝ_k|ε ≥ α(|ĝ_k| − ε)² and c α² ĝ_k² ≤ c α²(|ĝ_k| + ε)²), so it only
 //! differs from the step's own certificate by the rounding of the update; the second differs
 //! from the thesis form by the Θ(Δ³) terms Theorem 4.3 neglects (docs/ERRATA.md §10).
@@ -56,7 +58,8 @@ fn k_mu() -> Interval {
     Interval::new(k * (1.0 - 1e-13), k * (1.0 + 1e-13)).unwrap_or(Interval::ENTIRE)
 }
 
-/// An enclosure of c_ℝ(σ) (`sepg_bounds::rigorous::c`).
+/// An enclosure of c_ℝ(σ) (`sepg_bounds::rigorous::c`); for the tight family, whose c holds
+/// on ℝ, an enclosure of that c.
 ///
 /// # Formula
 /// ```text
@@ -69,6 +72,9 @@ fn c_real_line(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
             value: sigma,
             domain: "(0, inf)",
         });
+    }
+    if let sepg_bounds::Family::Tight(_) = k.family() {
+        return certified::c(k, sigma);
     }
     let om = Interval::point(1.0) - Interval::point(k.gamma());
     let s = Interval::point(sigma);

@@ -62,3 +62,62 @@ fn sigma_outside_the_range_takes_the_interval_path() {
     assert!(step(2f64.powi(-100)).by_error_bound);
     assert!(!step(2f64.powi(-100) * 0.99).by_error_bound);
 }
+
+/// With the tight constants (docs/THEOREMS.md "Tight constants") the a-priori analysis, which
+/// counts the roundings of the thesis's formulas, does not apply: every step is certified in
+/// interval arithmetic, the enclosures of c and d contain the `f64` values and the exact
+/// S_H, and the certified bound is the tight parabola's.
+#[test]
+fn tight_constants_are_certified_by_enclosure() {
+    use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+    let base = TaskConstants::new(0.99, 28.8, 4.0, 8.0).expect("valid");
+    for (horizon, rewards) in [
+        (Horizon::Finite(20), Rewards::NonPositive),
+        (Horizon::Finite(1), Rewards::TwoSided),
+        (Horizon::Finite(3_000_000), Rewards::TwoSided),
+        (Horizon::Infinite, Rewards::NonPositive),
+    ] {
+        let k = base
+            .with_family(Family::Tight(Tight::new(horizon, rewards)))
+            .expect("valid");
+        let task = CertifiedTask::new(&k);
+        assert!(!task.in_rounding_range());
+        let rho = if rewards == Rewards::NonPositive {
+            0.5
+        } else {
+            1.0
+        };
+        // S_H from an independent term-by-term sum (H = 20, 1), or S_∞
+        let s = match horizon {
+            Horizon::Finite(h) if h < 100 => (0..h)
+                .map(|t| (t + 1) as f64 * 0.99f64.powi(t as i32))
+                .sum(),
+            _ => 1e4,
+        };
+        for sigma in [0.05, 0.3, 1.0, 4.0] {
+            let c = sepg_certified::c(&k, sigma).expect("valid");
+            let d = sepg_certified::d(&k, sigma).expect("valid");
+            assert!(c.contains(sepg_bounds::constants::c(&k, sigma).expect("finite")));
+            assert!(d.contains(sepg_bounds::constants::d(&k, sigma).expect("finite")));
+            let c_exact = rho * 28.8 * 16.0 * s / (sigma * sigma);
+            assert!(c.lo() <= c_exact * (1.0 + 1e-12) && c.hi() >= c_exact * (1.0 - 1e-12));
+            for required in [0.0, -1e-3] {
+                let grad = [-3.7 * c.hi().sqrt()];
+                match v_safe_step(&task, sigma, &grad, required).expect("valid") {
+                    Certified::Step(st) => {
+                        assert!(!st.by_error_bound && st.bound.lo() >= required);
+                        // the bound of the tight parabola at the step: x‖∇‖² − c x²‖∇‖²
+                        let g2 = grad[0] * grad[0];
+                        let plain = st.step * g2 - c.hi() * st.step * st.step * g2;
+                        assert!(plain >= required - 1e-12 * g2.abs());
+                    }
+                    other => panic!("expected a certified step, got {other:?}"),
+                }
+                match w_safe_step_along_j(&task, sigma, 0.8, required).expect("valid") {
+                    Certified::Step(st) => assert!(st.bound.lo() >= required),
+                    other => panic!("expected a certified w-step, got {other:?}"),
+                }
+            }
+        }
+    }
+}
