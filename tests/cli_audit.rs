@@ -18,7 +18,7 @@ use sepg_mdp::oracle::{ClippedDpOracle, DpConfig, ExactOracle, Exploration, Hori
 
 use crate::common::{assert_usage_error, readme_run, sepg, sepg_ok};
 
-pub(crate) fn path(dir: &Path) -> &str {
+fn path(dir: &Path) -> &str {
     dir.to_str().expect("utf-8 path")
 }
 
@@ -654,11 +654,12 @@ pub(crate) fn tail_by_sum(k: u64, n: u64, p: f64) -> f64 {
 #[test]
 fn a_statement_per_iteration_counts_failures_over_iterations_not_steps() {
     // The README's sampled ZV run (δ = 0.2), 300 iterations, read as a proven statement per
-    // iteration. Only the rows chosen below take a v-step (α ≠ 0).
+    // iteration over its two widths (v and w, each at δ: 0.4 per iteration). Only the rows
+    // chosen below take a v-step (α ≠ 0).
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("zv");
     sepg_ok(&readme_run(&dir, 300));
-    set_statement(&dir, "proven", "iteration", Some(0.2));
+    set_statement(&dir, "proven", "iteration", Some(0.4));
     set_cell(&dir, "alpha", None, "0.0");
     let steps = |failing: u64, holding: u64| {
         for t in 0..failing + holding {

@@ -21,7 +21,7 @@ use sepg_mdp::lqg_model::LqgModel;
 use sepg_mdp::oracle::{ClippedDpOracle, DpConfig, ExactOracle, Exploration, Horizon, Needs};
 
 use crate::cli_audit::{
-    audit_json, audit_json_with, cell, check, path, run, set_cell, set_statement, tail_by_sum,
+    audit_json, audit_json_with, cell, check, run, set_cell, set_statement, tail_by_sum,
 };
 
 /// The audit's default relative tolerance: a shortfall up to 1e-12 · max(1, |J|) is the
@@ -422,7 +422,7 @@ fn confidence_none_from_the_optimum_is_no_guarantee_and_counts_its_genuine_failu
 /// statement about the whole run at δ = 0.2. θ⁸ moved to v = +0.5 puts J(θ⁸) far below
 /// J(θ⁰) − B⁰: the budget requirement, cumulative, is violated by the update of iteration 7
 /// and by no other. One exact violation breaks a run-level statement, at iteration 7; read
-/// per iteration, one first failure at iteration 7 is what (7 + 1) · K · δ ≥ 1 allows.
+/// per iteration, one first failure at iteration 7 is what (7 + 1)·k·δ/K ≥ 1 allows (k = K).
 #[test]
 fn one_violation_of_the_budget_breaks_a_run_level_statement_at_its_iteration() {
     let tmp = tempfile::tempdir().expect("tempdir");
