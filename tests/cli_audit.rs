@@ -23,7 +23,7 @@ fn path(dir: &Path) -> &str {
 }
 
 /// `sepg run ... --quiet --out dir`, asserting success.
-fn run(dir: &Path, args: &[&str]) {
+pub(crate) fn run(dir: &Path, args: &[&str]) {
     let mut all = vec!["run", "--quiet", "--out", path(dir)];
     all.extend_from_slice(args);
     sepg_ok(&all);
@@ -51,7 +51,7 @@ fn exact_run_with(dir: &Path, algo: &str, extra: &[&str]) {
     run(dir, &args);
 }
 
-fn audit_json_with(dir: &Path, extra: &[&str]) -> (Option<i32>, serde_json::Value) {
+pub(crate) fn audit_json_with(dir: &Path, extra: &[&str]) -> (Option<i32>, serde_json::Value) {
     let mut args = vec!["audit", "--json"];
     args.extend_from_slice(extra);
     args.push(path(dir));
@@ -65,12 +65,12 @@ fn audit_json_with(dir: &Path, extra: &[&str]) -> (Option<i32>, serde_json::Valu
     (out.status.code(), report)
 }
 
-fn audit_json(dir: &Path) -> (Option<i32>, serde_json::Value) {
+pub(crate) fn audit_json(dir: &Path) -> (Option<i32>, serde_json::Value) {
     audit_json_with(dir, &[])
 }
 
 /// The summary of check `name` in a JSON report.
-fn check<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+pub(crate) fn check<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
     report["checks"]
         .as_array()
         .expect("checks")
@@ -81,7 +81,7 @@ fn check<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value
 
 /// Replaces, in `log.csv`, the cell of column `column` on the row of `iteration` (every row
 /// when `iteration` is `None`) by `value`.
-fn set_cell(dir: &Path, column: &str, iteration: Option<u64>, value: &str) {
+pub(crate) fn set_cell(dir: &Path, column: &str, iteration: Option<u64>, value: &str) {
     let p = dir.join("log.csv");
     let text = fs::read_to_string(&p).expect("log.csv");
     let mut lines = text.lines();
@@ -102,7 +102,7 @@ fn set_cell(dir: &Path, column: &str, iteration: Option<u64>, value: &str) {
 }
 
 /// The cell of column `column` on the row of `iteration`.
-fn cell(dir: &Path, column: &str, iteration: u64) -> f64 {
+pub(crate) fn cell(dir: &Path, column: &str, iteration: u64) -> f64 {
     let text = fs::read_to_string(dir.join("log.csv")).expect("log.csv");
     let mut lines = text.lines();
     let col = lines
@@ -122,7 +122,7 @@ fn cell(dir: &Path, column: &str, iteration: u64) -> f64 {
 }
 
 /// Edits `summary.json` of `dir` with `edit`.
-fn edit_summary(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+pub(crate) fn edit_summary(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
     let p = dir.join("summary.json");
     let mut s: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(&p).expect("summary")).expect("json");
@@ -132,7 +132,7 @@ fn edit_summary(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
 
 /// Sets the statement of the run in `dir` to `kind`, `scope`, `delta`, keeping what it
 /// covers and its requirement.
-fn set_statement(dir: &Path, kind: &str, scope: &str, delta: Option<f64>) {
+pub(crate) fn set_statement(dir: &Path, kind: &str, scope: &str, delta: Option<f64>) {
     edit_summary(dir, |s| {
         let st = &mut s["statement"];
         st["kind"] = kind.into();
@@ -643,7 +643,7 @@ fn the_runs_own_bookkeeping_is_reported_on_its_own_line() {
 
 /// P(X ≥ k) for X ~ Binomial(n, p), summed term by term in f64 from exact binomial
 /// coefficients (relative error below n·1e-15 for n ≤ 1000).
-fn tail_by_sum(k: u64, n: u64, p: f64) -> f64 {
+pub(crate) fn tail_by_sum(k: u64, n: u64, p: f64) -> f64 {
     let ln_choose =
         |n: u64, i: u64| -> f64 { (1..=i).map(|j| ((n - i + j) as f64 / j as f64).ln()).sum() };
     (k..=n)
@@ -654,11 +654,12 @@ fn tail_by_sum(k: u64, n: u64, p: f64) -> f64 {
 #[test]
 fn a_statement_per_iteration_counts_failures_over_iterations_not_steps() {
     // The README's sampled ZV run (δ = 0.2), 300 iterations, read as a proven statement per
-    // iteration. Only the rows chosen below take a v-step (α ≠ 0).
+    // iteration over its two widths (v and w, each at δ: 0.4 per iteration). Only the rows
+    // chosen below take a v-step (α ≠ 0).
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("zv");
     sepg_ok(&readme_run(&dir, 300));
-    set_statement(&dir, "proven", "iteration", Some(0.2));
+    set_statement(&dir, "proven", "iteration", Some(0.4));
     set_cell(&dir, "alpha", None, "0.0");
     let steps = |failing: u64, holding: u64| {
         for t in 0..failing + holding {

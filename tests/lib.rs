@@ -1,6 +1,7 @@
 //! Integration tests of the `sepg` command-line interface, compiled into one binary.
 
 mod cli_audit;
+mod cli_audit_review;
 mod cli_bounds;
 mod cli_certified;
 mod cli_cluster;

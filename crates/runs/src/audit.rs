@@ -42,15 +42,16 @@
 //! - kind `none`: nothing is promised; every check is reported ([`Test::Reported`]).
 //! - scope `run`, or exact gradients (δ = null, a certainty): one failure of a covered check
 //!   breaks the promise ([`Test::OneFailure`]).
-//! - scope `iteration`: each iteration's step fails with probability at most K·δ given the
-//!   past, K the number of scalar confidence events it rests on (the statement's own union
-//!   bound: the l·p components of ∇̂_v J for `guarantee-v`, the l of ∇̂_w J for `guarantee-w`,
-//!   both for `mi`). The failure count over n iterations is then stochastically below
-//!   Binomial(n, K·δ), tested exactly ([`Test::Binomial`]: P(X ≥ failed) < α/m rejects, m the
-//!   number of tested checks, Bonferroni). The floors `lb-i`, `budget-exact` and
-//!   `budget-target` rest on every event up to their iteration (their failures persist), so
-//!   no per-iteration null exists for them; the union bound gives
-//!   P(first failure at or before t) ≤ (t + 1)·K·δ, and that is the test
+//! - scope `iteration`: the statement's δ bounds, given the past, the probability that any
+//!   of the iteration's K scalar confidence statements fails (its own union bound, each
+//!   statement at δ/K; K as the run counts them). A check resting on k of them (the l·p
+//!   components of ∇̂_v J for `guarantee-v`, the l of ∇̂_w J for `guarantee-w`, both for
+//!   `mi`) fails with probability at most k·δ/K; its failure count over n iterations is then
+//!   stochastically below Binomial(n, k·δ/K), tested exactly ([`Test::Binomial`]:
+//!   P(X ≥ failed) < α/m rejects, m the number of tested checks, Bonferroni). The floors
+//!   `lb-i`, `budget-exact` and `budget-target` rest on every event up to their iteration
+//!   (their failures persist), so no per-iteration null exists for them; the union bound
+//!   gives P(first failure at or before t) ≤ (t + 1)·k·δ/K, and that is the test
 //!   ([`Test::FirstFailure`]).
 //!
 //! A rejected check is [`Judgement::Broken`] under a proven statement and
@@ -239,7 +240,8 @@ pub struct CheckSummary {
     pub worst_shortfall: f64,
     /// Iteration of the worst shortfall.
     pub worst_iteration: u64,
-    /// Scope `iteration`: the per-iteration failure probability the statement allows (K·δ).
+    /// Scope `iteration`: the per-iteration failure probability the statement allows this
+    /// check (k·δ/K, see the module documentation).
     pub allowed_rate: Option<f64>,
     /// Scope `iteration`: the p-value of its test.
     pub p_value: Option<f64>,
@@ -815,7 +817,11 @@ fn source(env: &AnyEnv, horizon: usize, dim_v: usize) -> Result<(Option<ExactJ>,
 /// The statement a run is judged by, and whether it was recorded (see the module
 /// documentation): the summary's, else — for an older summary — the configuration's with
 /// scope `iteration` and kind `approximate`, else (an unfinished run) the configuration's.
-fn judged_statement(summary: Option<&Summary>, derived: Statement) -> (Statement, bool) {
+fn judged_statement(
+    summary: Option<&Summary>,
+    derived: Statement,
+    per_iteration: usize,
+) -> (Statement, bool) {
     match summary {
         Some(Summary {
             statement: Some(s), ..
@@ -824,6 +830,11 @@ fn judged_statement(summary: Option<&Summary>, derived: Statement) -> (Statement
             Statement {
                 kind: StatementKind::Approximate,
                 scope: Scope::Iteration,
+                // those runs set every width at δ: an iteration's K statements fail together
+                // with probability at most K·δ
+                delta: derived
+                    .delta
+                    .map(|d| (d * per_iteration.max(1) as f64).min(1.0)),
                 reasons: vec!["written before statements were recorded".to_owned()],
                 ..derived
             },
@@ -853,11 +864,13 @@ const CHECK_ORDER: [&str; 7] = [
 ];
 
 /// The checks of `requirement` (none for the comparison algorithms) and how `statement`
-/// judges them, for `dims` = (l·p, l) parameters.
+/// judges them, for `dims` = (l·p, l) parameters and `per_iteration` = K, the number of
+/// scalar confidence statements one iteration rests on (the union a per-iteration δ covers).
 fn plans(
     requirement: Option<Requirement>,
     statement: &Statement,
     dims: (usize, usize),
+    per_iteration: usize,
 ) -> Vec<Plan> {
     let Some(r) = requirement else {
         return Vec::new();
@@ -898,8 +911,15 @@ fn plans(
             } else {
                 Test::FirstFailure
             };
-            let rate = matches!(test, Test::Binomial | Test::FirstFailure)
-                .then(|| (events as f64 * statement.delta.unwrap_or(1.0)).min(1.0));
+            // A per-iteration δ bounds the union of the iteration's K statements, each at
+            // δ/K; a check resting on `events` of them fails with probability at most
+            // events·δ/K (δ = 1 promises nothing).
+            let rate = matches!(test, Test::Binomial | Test::FirstFailure).then(|| match statement
+                .delta
+            {
+                Some(d) if d < 1.0 => (events as f64 * d / per_iteration.max(1) as f64).min(1.0),
+                _ => 1.0,
+            });
             Plan { name, test, rate }
         })
         .collect()
@@ -1199,8 +1219,16 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
         GradientMode::Exact => "exact".to_owned(),
         GradientMode::Sampled { delta } => format!("sampled (δ = {delta})"),
     };
-    let (statement, statement_recorded) =
-        judged_statement(progress.summary.as_ref(), resolved.checked.statement());
+    let per_iteration = sepg_algo::solver::statements_per_iteration(
+        config.algorithm,
+        &config.options,
+        resolved.dims,
+    );
+    let (statement, statement_recorded) = judged_statement(
+        progress.summary.as_ref(),
+        resolved.checked.statement(),
+        per_iteration,
+    );
     if let Some(d) = statement.delta
         && !(d > 0.0 && d < 1.0)
     {
@@ -1210,7 +1238,7 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
         ));
     }
     let self_check = progress.summary.as_ref().and_then(|s| s.self_check);
-    let mut plans = plans(requirement, &statement, resolved.dims);
+    let mut plans = plans(requirement, &statement, resolved.dims, per_iteration);
     if exact.is_none() {
         // Without exact J only the run's own bookkeeping can be read from the log.
         plans.retain(|p| p.name == "budget");
@@ -1600,7 +1628,7 @@ mod tests {
         next: &[(f64, f64)],
     ) -> (BTreeMap<&'static str, Tally>, Vec<Violation>) {
         let s = statement(StatementKind::Proven, Scope::Run, None, Covers::Exploratory);
-        let plans = plans(Some(r), &s, (1, 1));
+        let plans = plans(Some(r), &s, (1, 1), 2);
         let walk = Walk {
             requirement: Some(r),
             budget0,
@@ -1762,16 +1790,17 @@ mod tests {
 
     #[test]
     fn a_per_step_check_of_scope_iteration_divides_by_iterations_not_steps() {
-        // δ = 0.2 per iteration. 20 failures among 40 steps taken in 300 iterations: the
-        // per-step rate 0.5 would be rejected (P(Bin(40, 0.2) ≥ 20) < 1e-4), the
-        // per-iteration rate 0.067 is what δ allows.
+        // δ = 0.2 per width, two widths (v and w) per iteration: the statement's δ is 0.4.
+        // 20 failures among 40 steps taken in 300 iterations: the per-step rate 0.5 would be
+        // rejected (P(Bin(40, 0.2) ≥ 20) < 1e-4), the per-iteration rate 0.067 is what δ
+        // allows.
         let s = statement(
             StatementKind::Proven,
             Scope::Iteration,
-            Some(0.2),
+            Some(0.4),
             Covers::Exploratory,
         );
-        let plans = plans(Some(Requirement::Mi), &s, (1, 1));
+        let plans = plans(Some(Requirement::Mi), &s, (1, 1), 2);
         let tests: Vec<(&str, Test, Option<f64>)> =
             plans.iter().map(|p| (p.name, p.test, p.rate)).collect();
         assert_eq!(
@@ -1825,16 +1854,16 @@ mod tests {
         let s = statement(
             StatementKind::Proven,
             Scope::Iteration,
-            Some(1e-4),
+            Some(2e-4),
             Covers::Exploratory,
         );
-        let plans = plans(Some(Requirement::LbII), &s, (1, 1));
+        let plans = plans(Some(Requirement::LbII), &s, (1, 1), 2);
         let floor = plans
             .iter()
             .find(|p| p.name == "budget-exact")
             .expect("plan");
         assert_eq!((floor.test, floor.rate), (Test::FirstFailure, Some(2e-4)));
-        // P(first failure ≤ t) ≤ (t + 1)·2δ: a failure from iteration 9 on (p = 2e-3) is
+        // Widths at δ = 1e-4, two per iteration: P(first failure ≤ t) ≤ (t + 1)·2δ: a failure from iteration 9 on (p = 2e-3) is
         // below 0.01/3; one from iteration 49 (p = 1e-2) is not, however long it lasts.
         for (first, judgement) in [(9, Judgement::Broken), (49, Judgement::Holds)] {
             let mut tallies = BTreeMap::new();
@@ -1849,7 +1878,7 @@ mod tests {
     #[test]
     fn each_statement_promises_exactly_its_checks() {
         let names = |r, s: &Statement| -> Vec<(&str, Test)> {
-            plans(Some(r), s, (1, 1))
+            plans(Some(r), s, (1, 1), 2)
                 .iter()
                 .map(|p| (p.name, p.test))
                 .collect()
@@ -1901,7 +1930,7 @@ mod tests {
                 .iter()
                 .all(|(_, t)| *t == Test::Reported)
         );
-        assert!(plans(None, &run, (1, 1)).is_empty());
+        assert!(plans(None, &run, (1, 1), 2).is_empty());
     }
 
     #[test]
@@ -1921,11 +1950,12 @@ mod tests {
             "iterations_per_s": 0.0, "env_steps_per_s": 0.0
         }))
         .expect("an older summary");
-        let (s, recorded) = judged_statement(Some(&summary), derived.clone());
+        // δ = 0.2 per width, two widths per iteration: 0.4 per iteration.
+        let (s, recorded) = judged_statement(Some(&summary), derived.clone(), 2);
         assert!(!recorded);
         assert_eq!(
             (s.kind, s.scope, s.delta),
-            (StatementKind::Approximate, Scope::Iteration, Some(0.2))
+            (StatementKind::Approximate, Scope::Iteration, Some(0.4))
         );
         assert_eq!(s.reasons, ["written before statements were recorded"]);
         // A run that promises nothing (SIM-ν, the comparison algorithms) still promises
@@ -1934,7 +1964,7 @@ mod tests {
             covers: Covers::None,
             ..derived
         };
-        let (s, _) = judged_statement(Some(&summary), nothing);
+        let (s, _) = judged_statement(Some(&summary), nothing, 2);
         assert_eq!(s.kind, StatementKind::None);
     }
 
