@@ -319,7 +319,9 @@ fn adversarial_tasks(ctx: &CheckContext<'_>) -> Vec<Adversarial> {
                 let j_mean = |v: f64| -> f64 {
                     -spread
                         * (0..h)
-                            .map(|t| discount(t) * mean_event(v, v0, sigma, m_phi, (t + 1) as f64).0)
+                            .map(|t| {
+                                discount(t) * mean_event(v, v0, sigma, m_phi, (t + 1) as f64).0
+                            })
                             .sum::<f64>()
                 };
                 let curvature: f64 = spread
@@ -352,8 +354,7 @@ fn adversarial_tasks(ctx: &CheckContext<'_>) -> Vec<Adversarial> {
                     };
                     curvature += spread * discount(t) * d;
                 }
-                let (Some(up), Some(mid), Some(down)) = (j_w(step), j_w(0.0), j_w(-step))
-                else {
+                let (Some(up), Some(mid), Some(down)) = (j_w(step), j_w(0.0), j_w(-step)) else {
                     return vec![];
                 };
                 // H = 1: exactly K_W/4; H > 1: each step's fraction lies between its n = 1
