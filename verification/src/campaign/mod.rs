@@ -310,7 +310,7 @@ fn family(rng: &mut Xoshiro256PlusPlus) -> Family {
 /// The family of the adversarial grid's `index`-th configuration: every other one uses the
 /// tight constants, cycling through H ∈ {1, 20, 200, ∞} and both reward signs.
 fn adversarial_family(index: usize) -> Family {
-    if index % 2 == 0 {
+    if index.is_multiple_of(2) {
         return Family::Thesis;
     }
     let horizons = [
@@ -320,7 +320,7 @@ fn adversarial_family(index: usize) -> Family {
         Horizon::Infinite,
     ];
     let k = index / 2;
-    let rewards = if (k / horizons.len()) % 2 == 0 {
+    let rewards = if (k / horizons.len()).is_multiple_of(2) {
         Rewards::NonPositive
     } else {
         Rewards::TwoSided
