@@ -492,3 +492,59 @@ pub(crate) fn checks() -> Vec<Check> {
         Check::new(adversarial, curvature_adversarial),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use statrs::distribution::Continuous;
+
+    #[test]
+    fn the_chi_square_route_gives_k_w_at_one_degree_of_freedom() {
+        // n = 1: Q = z², the event is z⁴ − 4z² + 1 > 0 and ∂²P/∂w² = E[(z⁴ − 4z² + 1)⁺] =
+        // K_W/2; K_W = 1.8321260494 (Simpson's rule on E|z⁴ − 4z² + 1|, below).
+        let (_, d2) = w_event(0.0, 1.0).unwrap();
+        assert_relative_eq!(d2, k_w() / 2.0, max_relative = 1e-12);
+        let n = 200_000;
+        let h = 20.0 / n as f64;
+        let simpson: f64 = (0..=n)
+            .map(|i| {
+                let z = -10.0 + i as f64 * h;
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * (z.powi(4) - 4.0 * z * z + 1.0).abs() * pdf(z)
+            })
+            .sum::<f64>()
+            * h
+            / 3.0;
+        assert_relative_eq!(k_w(), simpson, max_relative = 1e-7);
+    }
+
+    #[test]
+    fn the_chi_square_density_is_statrs_s() {
+        for n in [1.0, 2.0, 7.0, 20.0] {
+            let chi = ChiSquared::new(n).unwrap();
+            for x in [0.05, 1.0, 3.3, 21.0, 40.0] {
+                assert_relative_eq!(chi2_pdf(x, n), chi.pdf(x), max_relative = 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn the_mean_event_reaches_two_phi_one_at_its_centre() {
+        // 2φ(1) = 2 e^{−1/2}/√(2π) = 0.48394144903828673
+        // P(|z| > 1) = erfc(1/√2) = 0.3173105078629141 (statrs' erfc: within 1e-10 here)
+        let (p, d2) = mean_event(-0.3, -0.3, 0.5, 4.0, 7.0);
+        assert_relative_eq!(p, 0.317_310_507_862_914_1, max_relative = 1e-9);
+        assert_relative_eq!(
+            d2,
+            0.483_941_449_038_286_7 * 7.0 * 16.0 / 0.25,
+            max_relative = 1e-12
+        );
+    }
+}
