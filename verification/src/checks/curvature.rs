@@ -77,8 +77,9 @@ impl Tightest {
 }
 
 /// The grid of the preset check: v values (the optimal gain v* of the presets' unclipped
-/// twin, points where the action clip binds at most states and an expanding closed loop
-/// A + Bv > 1 whose states reach the clipped box) and log-spaced σ in [0.05, 4].
+/// twin; v = −1.9, where the mean v·s leaves the action box for about half of the initial
+/// states; v = 0.6, an expanding closed loop A + Bv > 1 whose states reach the clipped box)
+/// and log-spaced σ in [0.05, 4].
 fn preset_grid(quick: bool) -> (Vec<f64>, Vec<f64>) {
     // both presets have A = B = 1, Q = R and γ = 0.99: the same v* (thesis §5.1: −0.615)
     let v_star = ClosedFormOracle::new(&LqgModel::lqg1d())
@@ -434,8 +435,9 @@ pub(crate) fn checks() -> Vec<Check> {
         sampling: "fixed grid: presets lqg and lqg1d (γ = 0.99, their R, M_φ), H ∈ {1, 20, 50}, \
                    σ log-spaced in [0.05, 4] (9 points; quick: 3), v ∈ {−1.9, −1.4, −1, v*, \
                    −0.3, −0.1, 0, 0.3, 0.6} (quick: −1.9, v*, 0.6), v* = −0.6153 the optimal \
-                   gain of the unclipped twin; at −1.9 the action clip binds for most states, \
-                   at 0.6 the closed loop expands and the state clip binds"
+                   gain of the unclipped twin; at −1.9 the mean leaves the action box for about \
+                   half of the initial states, at 0.6 the closed loop expands and the state \
+                   clip binds"
             .into(),
         kind: ClaimKind::UpperBound,
         cases_full: 1,
