@@ -40,6 +40,13 @@ pub struct BoundFns {
     /// Theorem 4.2, eqs. (4.9)–(4.10): safe step sizes for a required improvement C
     /// (default `sepg_bounds::v_update::safe_step`).
     pub v_safe_step: fn(&TaskConstants, f64, &[f64], f64) -> Result<StepOutcome, BoundsError>,
+    /// The penalty c(σ) of the task constants' family, for the tight constants of
+    /// docs/THEOREMS.md "Tight constants" c = ρ R M_φ² S_H / σ² (default
+    /// `sepg_bounds::constants::c`).
+    pub tight_c: fn(&TaskConstants, f64) -> Result<f64, BoundsError>,
+    /// The penalty d(σ) of the task constants' family, for the tight constants d = 2ρ R S_H
+    /// (default `sepg_bounds::constants::d`).
+    pub tight_d: fn(&TaskConstants, f64) -> Result<f64, BoundsError>,
 }
 
 impl Default for BoundFns {
@@ -59,6 +66,8 @@ impl Default for BoundFns {
             l1_squared_bound,
             v_update_bound: sepg_bounds::v_update::bound,
             v_safe_step: sepg_bounds::v_update::safe_step,
+            tight_c: sepg_bounds::constants::c,
+            tight_d: sepg_bounds::constants::d,
         }
     }
 }

@@ -489,3 +489,67 @@ fn finite_mdp_rejects_bad_input() {
             .is_err()
     );
 }
+
+#[test]
+fn a_wrong_factor_in_the_tight_constants_is_caught() {
+    use sepg_bounds::constants::{c, d};
+    // The adversarial tasks reach the closed-form fractions 2φ(1) = 0.484 (c) and
+    // K_W/4 = 0.458 (d) of the bound: c or d halved, or doubled, changes the fraction.
+    let halved_c = BoundFns {
+        tight_c: |k, s| c(k, s).map(|x| 0.5 * x),
+        ..BoundFns::default()
+    };
+    let halved_d = BoundFns {
+        tight_d: |k, s| d(k, s).map(|x| 0.5 * x),
+        ..BoundFns::default()
+    };
+    let doubled_c = BoundFns {
+        tight_c: |k, s| c(k, s).map(|x| 2.0 * x),
+        ..BoundFns::default()
+    };
+    for b in [halved_c, halved_d, doubled_c] {
+        assert_eq!(
+            run_broken("thm-t-curvature-adversarial", b),
+            ("violated", false)
+        );
+    }
+    // Divided by 2.2 (beyond 1/0.484 = 2.07), c fails Theorem T's inequality itself there.
+    let check = registry()
+        .into_iter()
+        .find(|c| c.meta.id == "thm-t-curvature-adversarial")
+        .unwrap();
+    let r = check
+        .with_bounds(BoundFns {
+            tight_c: |k, s| c(k, s).map(|x| x / 2.2),
+            ..BoundFns::default()
+        })
+        .run(&RunConfig {
+            seed: 0,
+            quick: true,
+        });
+    assert_eq!(r.outcome.label(), "violated");
+    let above_one = r
+        .figures
+        .iter()
+        .filter(|f| f.name.starts_with("mean") && f.value.parse::<f64>().unwrap() > 1.0)
+        .count();
+    assert_eq!(above_one, 12, "{:?}", r.figures);
+    // On the clipped presets the largest one-sided fraction of 2c is 0.071 (lqg, H = 1):
+    // c divided by 20 is caught there, c divided by 10 is not.
+    let c_over_20 = BoundFns {
+        tight_c: |k, s| c(k, s).map(|x| x / 20.0),
+        ..BoundFns::default()
+    };
+    assert_eq!(
+        run_broken("thm-t-curvature-presets", c_over_20),
+        ("violated", false)
+    );
+    let c_over_10 = BoundFns {
+        tight_c: |k, s| c(k, s).map(|x| x / 10.0),
+        ..BoundFns::default()
+    };
+    assert_eq!(
+        run_broken("thm-t-curvature-presets", c_over_10),
+        ("holds", true)
+    );
+}

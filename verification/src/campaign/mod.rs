@@ -17,7 +17,11 @@
 //!
 //! Configurations are random (log-uniform constants, σ, gradients with both signs, subnormal
 //! and huge gradients, requirements C = C_max·(1 − k·2⁻⁵²), C_max/2, 0, −C_max, −10·C_max)
-//! or adversarial (a fixed grid of extreme values). Every chunk of 256 configurations has its
+//! or adversarial (a fixed grid of extreme values). Half of them (every other one in the grid)
+//! take c and d from the tight constants of docs/THEOREMS.md "Tight constants" instead of the
+//! thesis's, with a horizon in {1, …, 200} or ∞ and either reward sign: there c = ρRM²S_H/σ²,
+//! d = 2ρRS_H with S_H summed exactly, the c on ℝ of an applied mean change is c itself and
+//! the rigorous w-bound is Δw·∇_wJ − dΔw². Every chunk of 256 configurations has its
 //! own Xoshiro256++ stream derived from (seed, chunk), so the tallies do not depend on the
 //! number of threads.
 
@@ -31,6 +35,7 @@ use rayon::prelude::*;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
+use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use sepg_bounds::{exploring, pirotta, rigorous, v_update, w_update};
 use sepg_certified::{self as certified, Certified};
 
@@ -105,6 +110,9 @@ pub struct FormTally {
     pub realised_violations: u64,
     /// Applied updates that report not meeting C (no `f64` change passed: nothing moved).
     pub realised_unmet: u64,
+    /// Certified steps whose task constants are of the tight family (docs/THEOREMS.md "Tight
+    /// constants"), included in `certified_steps`.
+    pub tight_certified_steps: u64,
 }
 
 impl FormTally {
@@ -126,6 +134,7 @@ impl FormTally {
         self.realised += o.realised;
         self.realised_violations += o.realised_violations;
         self.realised_unmet += o.realised_unmet;
+        self.tight_certified_steps += o.tight_certified_steps;
         if o.max_ulps > self.max_ulps {
             self.max_ulps = o.max_ulps;
             self.largest_move = o.largest_move;
@@ -189,6 +198,8 @@ struct Case {
     eps_l: f64,
     /// How C is chosen from the form's C_max.
     requirement: Requirement,
+    /// The family of the penalty coefficients c and d.
+    family: Family,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -273,11 +284,52 @@ fn random_case(rng: &mut Xoshiro256PlusPlus) -> Case {
         eps_j,
         eps_l,
         requirement: requirement(rng),
+        family: family(rng),
     }
 }
 
+/// Half of the random configurations use the tight constants, with a horizon uniform in
+/// {1, …, 200} (or ∞, one time in ten) and either reward sign.
+fn family(rng: &mut Xoshiro256PlusPlus) -> Family {
+    if rng.random::<bool>() {
+        return Family::Thesis;
+    }
+    let horizon = if rng.random_range(0..10) == 0 {
+        Horizon::Infinite
+    } else {
+        Horizon::Finite(rng.random_range(1..=200))
+    };
+    let rewards = if rng.random::<bool>() {
+        Rewards::NonPositive
+    } else {
+        Rewards::TwoSided
+    };
+    Family::Tight(Tight::new(horizon, rewards))
+}
+
+/// The family of the adversarial grid's `index`-th configuration: every other one uses the
+/// tight constants, cycling through H ∈ {1, 20, 200, ∞} and both reward signs.
+fn adversarial_family(index: usize) -> Family {
+    if index.is_multiple_of(2) {
+        return Family::Thesis;
+    }
+    let horizons = [
+        Horizon::Finite(1),
+        Horizon::Finite(20),
+        Horizon::Finite(200),
+        Horizon::Infinite,
+    ];
+    let k = index / 2;
+    let rewards = if (k / horizons.len()).is_multiple_of(2) {
+        Rewards::NonPositive
+    } else {
+        Rewards::TwoSided
+    };
+    Family::Tight(Tight::new(horizons[k % horizons.len()], rewards))
+}
+
 /// The fixed adversarial grid: extreme σ, γ, huge and subnormal gradients with mixed signs,
-/// and C within 32 ulps of C_max.
+/// and C within 32 ulps of C_max; every other configuration with the tight constants.
 fn adversarial_cases() -> Vec<Case> {
     let mut out = Vec::new();
     let gammas = [0.0, 0.5, 0.99, 0.999_999];
@@ -311,6 +363,7 @@ fn adversarial_cases() -> Vec<Case> {
                         eps_j: gj.abs() / 3.0,
                         eps_l: gl.abs() / 3.0,
                         requirement,
+                        family: adversarial_family(out.len()),
                     });
                 }
             }
@@ -327,6 +380,9 @@ struct Exact {
     m: Mp,
     volume: Mp,
     sigma: Mp,
+    /// ρ·S_H of the tight family (docs/THEOREMS.md "Tight constants"), `None` for the
+    /// thesis's constants.
+    tight: Option<Mp>,
     c: OnceCell<Option<Mp>>,
     d: OnceCell<Option<Mp>>,
 }
@@ -340,6 +396,10 @@ impl Exact {
             m: Mp::f(c.m_phi),
             volume: Mp::f(c.volume),
             sigma: Mp::f(c.sigma),
+            tight: match c.family {
+                Family::Tight(t) => rho_s_h(c.gamma, t),
+                _ => None,
+            },
             c: OnceCell::new(),
             d: OnceCell::new(),
         }
@@ -353,8 +413,12 @@ impl Exact {
         self.d.get_or_init(|| self.d_uncached()).clone()
     }
 
-    /// c(σ) = R M²/((1−γ)²σ²) · (|A|/(√(2π)σ) + γ/(2(1−γ))), Theorem 4.2.
+    /// c(σ) = R M²/((1−γ)²σ²) · (|A|/(√(2π)σ) + γ/(2(1−γ))), Theorem 4.2; for the tight
+    /// family c(σ) = ρ R M² S_H/σ².
     fn c_uncached(&self) -> Option<Mp> {
+        if let Some(rho_s) = &self.tight {
+            return self.r.mul(&self.m.sqr()).mul(rho_s).div(&self.sigma.sqr());
+        }
         let front = self
             .r
             .mul(&self.m.sqr())
@@ -366,7 +430,11 @@ impl Exact {
 
     /// c on ℝ: c with the box term replaced by max(|A|/(√(2π)σ), K_MU), K_MU = 4e^{−1/2}/√(2π)
     /// (docs/ERRATA.md §27), the curvature constant of the applied mean-coordinate change.
+    /// The tight family's c holds on ℝ: it is its own c_ℝ.
     fn c_real_line(&self) -> Option<Mp> {
+        if self.tight.is_some() {
+            return self.c();
+        }
         let front = self
             .r
             .mul(&self.m.sqr())
@@ -394,17 +462,26 @@ impl Exact {
         }
     }
 
-    /// d(σ) = R/(1−γ)² · (ψ|A|/(2σ) + γ/(1−γ)), Theorem 4.3.
+    /// d(σ) = R/(1−γ)² · (ψ|A|/(2σ) + γ/(1−γ)), Theorem 4.3; for the tight family
+    /// d = 2ρ R S_H.
     fn d_uncached(&self) -> Option<Mp> {
+        if let Some(rho_s) = &self.tight {
+            return Some(self.r.mul(rho_s).ldexp(1));
+        }
         let front = self.r.div(&self.one_minus.sqr())?;
         let box_term = mp::psi().mul(&self.volume).div(&self.sigma.ldexp(1))?;
         Some(front.mul(&box_term.add(&self.gamma.div(&self.one_minus)?)))
     }
 
     /// The rigorous w-bound f(Δw) = Δw ∇_wJ − a Δw² max(1, e^{−Δw}) − G·KL2(Δw) with
-    /// a = Rψ|A|/(2(1−γ)²σ), G = γR/(2(1−γ)³), at the exact Δw = β·u.
+    /// a = Rψ|A|/(2(1−γ)²σ), G = γR/(2(1−γ)³), at the exact Δw = β·u. For the tight family,
+    /// whose d bounds the curvature in w for every σ, it is Δw ∇_wJ − d Δw².
     fn rigorous(&self, grad_w_j: f64, beta: f64, u: f64) -> Option<Mp> {
         let dw = Dyadic::product(beta, u);
+        if self.tight.is_some() {
+            let dw = Mp::point(dw);
+            return Some(dw.mul(&Mp::f(grad_w_j)).sub(&self.d()?.mul(&dw.sqr())));
+        }
         let kl = mp::kl2(&dw.abs());
         let dw = Mp::point(dw);
         let a = self
@@ -433,6 +510,26 @@ impl Exact {
                 .sub(&g.mul(&kl)),
         )
     }
+}
+
+/// ρ·S_H of the tight constants, exactly: S_H = Σ_{t<H} (t + 1) γᵗ by Horner's rule on exact
+/// rationals (H ≤ 200 here), S_∞ = 1/(1 − γ)²; ρ = 1/2 for non-positive rewards, 1 otherwise.
+fn rho_s_h(gamma: f64, tight: Tight) -> Option<Mp> {
+    let g = Mp::f(gamma);
+    let s = match tight.horizon() {
+        Horizon::Infinite => Mp::int(1).div(&Mp::int(1).sub(&g).sqr())?,
+        Horizon::Finite(h) => {
+            let mut acc = Mp::int(i64::try_from(h).ok()?);
+            for t in (0..h - 1).rev() {
+                acc = Mp::int(i64::try_from(t + 1).ok()?).add(&g.mul(&acc));
+            }
+            acc
+        }
+    };
+    Some(match tight.rewards() {
+        Rewards::NonPositive => s.ldexp(-1),
+        Rewards::TwoSided => s,
+    })
 }
 
 /// K_W = ∫_ℝ |z⁴ − 4z² + 1| φ(z) dz in closed form, enclosed.
@@ -753,7 +850,9 @@ fn tally_applied(
 /// Tallies one form on one case.
 fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     t.cases += 1;
-    let Ok(k) = TaskConstants::new(c.gamma, c.r_max, c.m_phi, c.volume) else {
+    let Ok(k) = TaskConstants::new(c.gamma, c.r_max, c.m_phi, c.volume)
+        .and_then(|k| k.with_family(c.family))
+    else {
         return;
     };
     let Some((required, uncertified, certified)) = outcomes(form, c, &k) else {
@@ -799,6 +898,7 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
         Certified::Step(st) => {
             tally_applied(t, form, index, c, &k, step, required, ex);
             t.certified_steps += 1;
+            t.tight_certified_steps += u64::from(matches!(c.family, Family::Tight(_)));
             if st.by_error_bound {
                 t.by_error_bound += 1;
             } else {

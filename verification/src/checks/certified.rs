@@ -29,6 +29,10 @@ fn certified_steps(ctx: &CheckContext<'_>) -> Evaluation {
             value: format!("{violated} of {uncertified}"),
         },
         Figure {
+            name: "certified steps with the tight constants".into(),
+            value: sum(|t| t.tight_certified_steps).to_string(),
+        },
+        Figure {
             name: "certified steps moved toward the vertex".into(),
             value: sum(|t| t.moved).to_string(),
         },
@@ -80,8 +84,9 @@ pub(crate) fn checks() -> Vec<Check> {
         sampling: format!(
             "random configurations (γ, R, M_φ, |A| log-uniform, σ ∈ [1e-10, 1e6], gradients \
              of both signs from subnormal to 1e150, C = C_max(1 − k·2⁻⁵²), C_max/2, 0, \
-             −C_max, −10·C_max) plus a fixed adversarial grid of {}; each in {} bound forms \
-             ({})",
+             −C_max, −10·C_max; half of them with the tight constants, H ∈ {{1, …, 200}} or \
+             ∞, either reward sign) plus a fixed adversarial grid of {} (every other one \
+             with the tight constants); each in {} bound forms ({})",
             adversarial_len(),
             FORMS.len(),
             FORMS.join(", ")

@@ -5,6 +5,7 @@ mod appendix_a;
 mod certified;
 mod chapter3;
 mod chapter4;
+mod curvature;
 mod exploring;
 mod lqg_exact;
 mod run_statement;
@@ -32,6 +33,7 @@ pub fn registry() -> Vec<Check> {
     checks.extend(algorithm::checks());
     checks.extend(certified::checks());
     checks.extend(exploring::checks());
+    checks.extend(curvature::checks());
     checks.extend(run_statement::checks());
     for c in &mut checks {
         if c.meta.basis.is_empty() {
