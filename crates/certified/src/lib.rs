@@ -84,8 +84,8 @@ pub use enclosure::{
 };
 pub use interval::Interval;
 pub use steps::{
-    adaptive_step, direction_safe_step, exploring_safe_step, hp_v_safe_step, hp_w_safe_step_along_j,
-    hp_w_safe_step_along_l, rigorous_safe_step_along_j, rigorous_safe_step_along_l, v_safe_step,
-    w_safe_step_along_j, w_safe_step_along_l,
+    adaptive_step, direction_safe_step, exploring_safe_step, hp_v_safe_step,
+    hp_w_safe_step_along_j, hp_w_safe_step_along_l, rigorous_safe_step_along_j,
+    rigorous_safe_step_along_l, v_safe_step, w_safe_step_along_j, w_safe_step_along_l,
 };
 pub use task::{AsCertifiedTask, CertifiedTask};

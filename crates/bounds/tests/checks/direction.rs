@@ -95,7 +95,10 @@ fn the_largest_step_meets_the_requirement_and_is_the_largest() {
         assert!(t >= 0.0 && t <= cap);
         let scale = (t * a.abs()).max(required.abs()).max(1e-300);
         let at = b_ref(c2, &u, &g, &eps, t);
-        assert!(at >= required - 1e-9 * scale, "case {case}: B({t}) = {at} < {required}");
+        assert!(
+            at >= required - 1e-9 * scale,
+            "case {case}: B({t}) = {at} < {required}"
+        );
         assert!((s.guaranteed - at).abs() <= 1e-9 * scale, "case {case}");
         if t < cap && t > 0.0 {
             let beyond = b_ref(c2, &u, &g, &eps, t * (1.0 + 1e-9));
@@ -104,7 +107,10 @@ fn the_largest_step_meets_the_requirement_and_is_the_largest() {
         }
         if exact && t < cap {
             let root = (a + (a * a - 4.0 * bq * required).sqrt()) / (2.0 * bq);
-            assert!((t - root).abs() <= 1e-10 * root, "case {case}: {t} vs {root}");
+            assert!(
+                (t - root).abs() <= 1e-10 * root,
+                "case {case}: {t} vs {root}"
+            );
             checked.1 += 1;
         }
     }
@@ -169,8 +175,14 @@ fn the_penalty_follows_the_feature_norm_and_the_family() {
         .map(|b| b.penalty)
     };
     let rel = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y;
-    assert!(rel(penalty(FeatureNorm::FromMax { features: 5 }).expect("c2"), 5.0 * c));
-    assert!(rel(penalty(FeatureNorm::Stated(6.0)).expect("c2"), c * 36.0 / 16.0));
+    assert!(rel(
+        penalty(FeatureNorm::FromMax { features: 5 }).expect("c2"),
+        5.0 * c
+    ));
+    assert!(rel(
+        penalty(FeatureNorm::Stated(6.0)).expect("c2"),
+        c * 36.0 / 16.0
+    ));
     let thesis = TaskConstants::new(0.99, 28.8, 4.0, 8.0).expect("constants");
     let d = Direction {
         direction: &u,
@@ -198,7 +210,10 @@ fn bad_inputs_are_typed_errors() {
     let err = |d: Direction| DirectionBound::new(&k, 1.0, &d).err();
     assert!(matches!(
         err(make(&[0.0], &[1.0], &[0.0], f)),
-        Some(BoundsError::OutOfDomain { name: "direction", .. })
+        Some(BoundsError::OutOfDomain {
+            name: "direction",
+            ..
+        })
     ));
     assert!(matches!(
         err(make(&[1.0, 1.0], &[1.0], &[0.0, 0.0], f)),
@@ -213,11 +228,21 @@ fn bad_inputs_are_typed_errors() {
         Some(BoundsError::OutOfDomain { name: "eps", .. })
     ));
     assert!(matches!(
-        err(make(&[1.0], &[1.0], &[0.0], FeatureNorm::FromMax { features: 0 })),
+        err(make(
+            &[1.0],
+            &[1.0],
+            &[0.0],
+            FeatureNorm::FromMax { features: 0 }
+        )),
         Some(BoundsError::OutOfDomain { .. })
     ));
     assert!(matches!(
-        err(make(&[1.0, 1.0], &[1.0, 1.0], &[0.0, 0.0], FeatureNorm::Stated(-1.0))),
+        err(make(
+            &[1.0, 1.0],
+            &[1.0, 1.0],
+            &[0.0, 0.0],
+            FeatureNorm::Stated(-1.0)
+        )),
         Some(BoundsError::OutOfDomain { .. })
     ));
     assert!(err(make(&[], &[], &[], f)).is_some());

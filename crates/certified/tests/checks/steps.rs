@@ -139,7 +139,10 @@ fn direction_steps_are_certified_and_close_to_the_f64_step() {
         })
         .expect("constants");
     let mut n = 0;
-    for (i, u) in [[1e-2, -3e-3], [0.0, 0.7], [-1e-4, -1e-4]].iter().enumerate() {
+    for (i, u) in [[1e-2, -3e-3], [0.0, 0.7], [-1e-4, -1e-4]]
+        .iter()
+        .enumerate()
+    {
         for g in [[35.0, -4.0], [-0.3, 0.2], [1e-3, 12.0]] {
             for e in [0.0, 0.1, 3.0] {
                 for sigma in [0.1, 0.5, 1.0] {
@@ -171,7 +174,12 @@ fn direction_steps_are_certified_and_close_to_the_f64_step() {
                         assert!(s.step <= f.step && s.step <= cap && s.step >= 0.0);
                         assert!(s.bound.lo() >= required);
                         assert!(s.bound.contains(b.bound(s.step).expect("bound")));
-                        assert!(f.step - s.step <= 1e-12 * f.step, "{} vs {}", s.step, f.step);
+                        assert!(
+                            f.step - s.step <= 1e-12 * f.step,
+                            "{} vs {}",
+                            s.step,
+                            f.step
+                        );
                         n += 1;
                     }
                 }
