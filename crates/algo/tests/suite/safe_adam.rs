@@ -210,3 +210,78 @@ fn the_greedy_direction_is_the_default_and_is_not_serialised() {
         serde_json::from_str(&serde_json::to_string(&adam).expect("serialise")).expect("load");
     assert_eq!(back, adam);
 }
+
+/// One row of the measurement: |v − v*| at the end, exact violations, the final σ and the
+/// mean step fraction t of the run (1 for Adam).
+#[derive(Debug, Clone, Copy)]
+struct Outcome {
+    distance: f64,
+    violations: usize,
+    sigma: f64,
+    mean_t: f64,
+}
+
+/// Runs `c` for `iterations` and judges it against exact J.
+fn measure(exact: &ExactJ, c: &CheckedConfig, iterations: u64, half_steps: bool) -> Outcome {
+    let (records, last) = run_checked(c, iterations);
+    let mean_t = if half_steps {
+        records.iter().map(|r| r.alpha).sum::<f64>() / records.len() as f64
+    } else {
+        1.0
+    };
+    Outcome {
+        distance: (last.v[0] - v_star()).abs(),
+        violations: violations(exact, &points(&records, &last, half_steps)),
+        sigma: last.w[0].exp(),
+        mean_t,
+    }
+}
+
+/// The table of docs/REPRODUCTION.md, "Safe Adam": safe Adam (SEPG-MI, `VDirection::Adam`,
+/// tight constants, certified accounting) against G(PO)MDP + Adam (σ fixed) with the same
+/// learning rate, on the clipped `lqg1d` from v⁰ = −0.1, 2,000 iterations, (a) exact
+/// gradients, (b) sampled, N = 100, Student-t widths, δ = 0.2, seeds 0–9. Run with
+/// `cargo test --release -p sepg-algo --test lib measure_safe_adam -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement: prints the table of docs/REPRODUCTION.md (several minutes)"]
+fn measure_safe_adam_against_adam() {
+    use rayon::prelude::*;
+    let iterations = 2_000;
+    let sampled = GradientMode::Sampled { delta: 0.2 };
+    println!(
+        "| gradients | lr | σ⁰ | algorithm | \\|v − v*\\| (mean, max over seeds) | exact violations (total, runs with any) | final σ (mean) | mean t |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for lr in [1e-2, 1e-1] {
+        for sigma0 in [0.5, 1.0] {
+            for (name, mode, seeds) in [("exact", GradientMode::Exact, 1), ("sampled", sampled, 10)]
+            {
+                for safe in [false, true] {
+                    let outcomes: Vec<Outcome> = (0..seeds)
+                        .into_par_iter()
+                        .map(|seed| {
+                            let exact = ExactJ::new();
+                            let c = if safe {
+                                safe_adam(lr, sigma0, mode, seed)
+                            } else {
+                                adam(lr, sigma0, mode, seed)
+                            };
+                            measure(&exact, &c, iterations, safe)
+                        })
+                        .collect();
+                    let n = outcomes.len() as f64;
+                    let mean = outcomes.iter().map(|o| o.distance).sum::<f64>() / n;
+                    let max = outcomes.iter().map(|o| o.distance).fold(0.0, f64::max);
+                    let total: usize = outcomes.iter().map(|o| o.violations).sum();
+                    let runs = outcomes.iter().filter(|o| o.violations > 0).count();
+                    let sigma = outcomes.iter().map(|o| o.sigma).sum::<f64>() / n;
+                    let t = outcomes.iter().map(|o| o.mean_t).sum::<f64>() / n;
+                    println!(
+                        "| {name} | {lr} | {sigma0} | {} | {mean:.4}, {max:.4} | {total}, {runs}/{seeds} | {sigma:.3} | {t:.3} |",
+                        if safe { "safe Adam (SEPG-MI)" } else { "Adam" }
+                    );
+                }
+            }
+        }
+    }
+}
