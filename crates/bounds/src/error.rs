@@ -59,6 +59,11 @@ pub enum BoundsError {
     /// A target-policy operation was requested on a budget that tracks no target policy.
     #[error("this budget tracks no separate target policy")]
     NoTargetPolicy,
+    /// A step along a direction with several non-zero entries was asked of the thesis's
+    /// constants, whose c (Theorems 3.14, 4.2) is proven for the greedy coordinate only
+    /// (docs/THEOREMS.md, "A step along any direction").
+    #[error("the thesis's c is proven for a coordinate direction only: use the tight constants")]
+    UnprovenDirection,
 }
 
 /// Returns `value` if it is finite, otherwise [`BoundsError::NonFinite`] naming the input

@@ -29,6 +29,7 @@
 //! | [`rigorous`] | Theorem 4.3 without neglected terms (Lemmas A.1–A.3) |
 //! | [`budget`] | Definition 4.3, Theorem 4.1, eqs. (4.13)–(4.14) |
 //! | [`exploring`] | the exploring w-update: Theorem 4.3 with the confidence on ∇_w J only |
+//! | [`direction`] | a safe step along any proposed direction of v (Theorem T, docs/THEOREMS.md) |
 //!
 //! ```
 //! use sepg_bounds::{constants::TaskConstants, outcome::StepOutcome, v_update};
@@ -44,6 +45,7 @@
 pub mod batch_size;
 pub mod budget;
 pub mod constants;
+pub mod direction;
 pub mod error;
 pub mod exploring;
 pub mod greedy;

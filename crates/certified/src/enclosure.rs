@@ -2,6 +2,7 @@
 //! d(σ) and of each bound form of `sepg-bounds` at an exact step ([`EnclosedBound`]).
 
 use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::direction::{Direction, FeatureNorm};
 use sepg_bounds::error::{BoundsError, finite, finite_vector, inf_norm, non_negative, positive};
 use sepg_bounds::high_probability::HpForm;
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
@@ -143,6 +144,34 @@ pub fn d(k: &TaskConstants, sigma: f64) -> Result<Interval, BoundsError> {
     Ok(front * bracket)
 }
 
+/// κ_φ of a step along `d` (`sepg_bounds::direction`), enclosed: 1 for a coordinate
+/// direction, p, or (M₂/M_φ)² in interval arithmetic.
+///
+/// Errors: [`BoundsError::UnprovenDirection`] for a non-coordinate direction with the thesis
+/// family (the error of `Direction::feature_factor`).
+///
+/// ```
+/// use sepg_bounds::constants::TaskConstants;
+/// use sepg_bounds::direction::{Direction, FeatureNorm};
+/// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+/// let k = TaskConstants::new(0.9, 1.0, 3.0, 2.0)?
+///     .with_family(Family::Tight(Tight::new(Horizon::Infinite, Rewards::TwoSided)))?;
+/// let d = Direction { direction: &[1.0, 1.0], grad_hat: &[0.0, 0.0], eps: &[0.0, 0.0], features: FeatureNorm::Stated(0.3) };
+/// assert!(sepg_certified::enclosure::feature_factor(&k, &d)?.contains(0.01));
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn feature_factor(k: &TaskConstants, d: &Direction) -> Result<Interval, BoundsError> {
+    // validates the family and the coordinate case; the value is recomputed enclosed
+    let value = d.feature_factor(k)?;
+    Ok(match d.features {
+        FeatureNorm::Stated(m2) if !d.is_coordinate() => {
+            (Interval::point(m2) / Interval::point(k.m_phi())).sqr()
+        }
+        // 1 or p: integers, exact in f64 below 2⁵³
+        _ => Interval::point(value),
+    })
+}
+
 /// A bound B(x) on the guaranteed improvement of a step x that can be enclosed in interval
 /// arithmetic, with x taken as an exact real.
 ///
@@ -230,6 +259,38 @@ impl Quadratic {
         Ok(Self {
             linear: l * j,
             quadratic: d(k, sigma)? * l.sqr(),
+        })
+    }
+
+    /// A step t ≥ 0 along a proposed direction u (`sepg_bounds::direction`):
+    /// a = u·ĝ − Σ|u_i|ε_i, b = c(σ)·κ_φ·‖u‖₂², with c of the family of `k` and κ_φ of
+    /// [`feature_factor`]. Valid for t ≥ 0 only (the ε term is t·Σ|u_i|ε_i there).
+    ///
+    /// Errors: those of [`Direction::validate`], [`c`] and [`feature_factor`].
+    ///
+    /// ```
+    /// use sepg_bounds::constants::TaskConstants;
+    /// use sepg_bounds::direction::{Direction, DirectionBound, FeatureNorm};
+    /// use sepg_certified::{EnclosedBound, Quadratic};
+    /// let k = TaskConstants::new(0.9, 1.0, 1.0, 2.0)?;
+    /// let d = Direction { direction: &[0.5], grad_hat: &[0.3], eps: &[0.1], features: FeatureNorm::FromMax { features: 1 } };
+    /// let q = Quadratic::direction(&k, 1.0, &d)?;
+    /// assert!(q.enclose(0.2).contains(DirectionBound::new(&k, 1.0, &d)?.bound(0.2)?));
+    /// # Ok::<(), sepg_bounds::BoundsError>(())
+    /// ```
+    pub fn direction(k: &TaskConstants, sigma: f64, d: &Direction) -> Result<Self, BoundsError> {
+        d.validate()?;
+        let kappa = feature_factor(k, d)?;
+        let zero = Interval::point(0.0);
+        let (mut linear, mut norm2) = (zero, zero);
+        for ((&u, &g), &e) in d.direction.iter().zip(d.grad_hat).zip(d.eps) {
+            let u = Interval::point(u);
+            linear = linear + u.scale(g) - u.abs().scale(e);
+            norm2 = norm2 + u.sqr();
+        }
+        Ok(Self {
+            linear,
+            quadratic: c(k, sigma)? * kappa * norm2,
         })
     }
 

@@ -52,6 +52,7 @@
 //! | [`w_safe_step_along_l`] | β∇_wL∇_wJ − β²d(∇_wL)² | Theorem 4.5 |
 //! | [`hp_v_safe_step`], [`hp_w_safe_step_along_j`], [`hp_w_safe_step_along_l`] | high-probability forms | Theorems 4.7–4.9 |
 //! | [`rigorous_safe_step_along_j`], [`rigorous_safe_step_along_l`] | rigorous w-bound | [`sepg_bounds::rigorous`] |
+//! | [`direction_safe_step`] | t(u·ĝ) − tΣ\|u_i\|ε_i − c(σ)κ_φt²‖u‖₂² (any direction u) | docs/THEOREMS.md, Theorem T |
 //! | [`exploring_safe_step`] | Δw·∇̂_wJ − \|Δw\|·ε_J − d(σ)Δw² | docs/THEOREMS.md, Theorem E |
 //! | [`adaptive_step`] | α‖∇J‖₂² − α²c(σ)‖∇J‖₁² (guarantee only) | Theorem 3.10, Corollary 3.11 |
 
@@ -83,8 +84,8 @@ pub use enclosure::{
 };
 pub use interval::Interval;
 pub use steps::{
-    adaptive_step, exploring_safe_step, hp_v_safe_step, hp_w_safe_step_along_j,
-    hp_w_safe_step_along_l, rigorous_safe_step_along_j, rigorous_safe_step_along_l, v_safe_step,
-    w_safe_step_along_j, w_safe_step_along_l,
+    adaptive_step, direction_safe_step, exploring_safe_step, hp_v_safe_step,
+    hp_w_safe_step_along_j, hp_w_safe_step_along_l, rigorous_safe_step_along_j,
+    rigorous_safe_step_along_l, v_safe_step, w_safe_step_along_j, w_safe_step_along_l,
 };
 pub use task::{AsCertifiedTask, CertifiedTask};

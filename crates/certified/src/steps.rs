@@ -9,7 +9,11 @@ use sepg_bounds::outcome::{SafeInterval, StepOutcome};
 use sepg_bounds::penalties::Penalties;
 use sepg_bounds::{pirotta, rigorous, v_update, w_update};
 
-use crate::certificate::{Certified, CertifiedStep, certify_fast_then_interval, certify_step};
+use sepg_bounds::direction::{Direction, DirectionBound};
+
+use crate::certificate::{
+    Certified, CertifiedStep, certify_fast_then_interval, certify_step, certify_toward,
+};
 use crate::enclosure::{
     EnclosedBound, ExploringEnclosure, HpEnclosure, Quadratic, RigorousEnclosure, c,
 };
@@ -555,6 +559,77 @@ fn exploring_safe_step_in(
     };
     certify_fast_then_interval(outcome, required, fast, move || {
         ExploringEnclosure::new(k, sigma, grad_w_j_hat, eps_j, grad_w_l_hat).map(Some)
+    })
+}
+
+/// Certified largest step t ∈ [0, `max_step`] along a proposed direction u
+/// (`sepg_bounds::direction::DirectionBound::safe_step`) for the requirement C: the returned
+/// t's enclosed bound has lower end ≥ C. Interval arithmetic only.
+///
+/// # Formula
+///
+/// ```text
+/// B(t) = t·(u·ĝ) − t·Σ|u_i|ε_i − c(σ)·κ_φ·t²·‖u‖₂²,   certified: enclosure of B(t) ≥ C
+/// ```
+///
+/// The `f64` step is moved toward 0 (toward the vertex when C > 0) by the fewest ulps whose
+/// enclosure passes; with C ≤ 0, t = 0 (bound exactly 0) always passes. Outcomes:
+/// [`Certified::Step`] (its `interval` the `f64` safe interval, `lo` clipped to 0),
+/// [`Certified::Infeasible`] (the best t within the cap, its bound below C) and
+/// [`Certified::Uncertifiable`].
+///
+/// Errors: those of [`DirectionBound::new`] and [`DirectionBound::safe_step`].
+///
+/// ```
+/// use sepg_bounds::constants::TaskConstants;
+/// use sepg_bounds::direction::{Direction, FeatureNorm};
+/// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+/// let k = TaskConstants::new(0.99, 28.8, 4.0, 8.0)?
+///     .with_family(Family::Tight(Tight::new(Horizon::Finite(20), Rewards::NonPositive)))?;
+/// let d = Direction {
+///     direction: &[1e-2, -1e-2],
+///     grad_hat: &[40.0, -10.0],
+///     eps: &[5.0, 5.0],
+///     features: FeatureNorm::FromMax { features: 2 },
+/// };
+/// let o = sepg_certified::direction_safe_step(&k, 1.0, &d, 0.0, 1.0)?;
+/// let t = o.chosen_step().unwrap();
+/// assert!(o.is_certified() && t > 0.0 && t <= 1.0 && o.bound().unwrap().lo() >= 0.0);
+/// # Ok::<(), sepg_bounds::BoundsError>(())
+/// ```
+pub fn direction_safe_step(
+    task: impl AsCertifiedTask,
+    sigma: f64,
+    d: &Direction,
+    required: f64,
+    max_step: f64,
+) -> Result<Certified, BoundsError> {
+    let k = task.constants();
+    let step = DirectionBound::new(k, sigma, d)?.safe_step(required, max_step)?;
+    let q = Quadratic::direction(k, sigma, d)?;
+    let StepOutcome::Feasible(interval) = step.outcome else {
+        return Ok(Certified::Infeasible {
+            step: step.step,
+            bound: q.enclose(step.step),
+        });
+    };
+    let toward = if required <= 0.0 {
+        0.0
+    } else {
+        interval.vertex.clamp(0.0, step.step)
+    };
+    Ok(match certify_toward(&q, step.step, toward, required) {
+        Ok((t, bound, ulps_moved)) => Certified::Step(CertifiedStep {
+            step: t,
+            bound,
+            ulps_moved,
+            interval,
+            by_error_bound: false,
+        }),
+        Err(bound) => Certified::Uncertifiable {
+            step: toward,
+            bound,
+        },
     })
 }
 

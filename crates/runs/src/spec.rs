@@ -815,6 +815,7 @@ impl RunSpec {
         }
         let sampled = gradients == GradientsName::Sampled;
         Some(SepgOptions {
+            v_direction: defaults.v_direction,
             w_step: match self.w_step {
                 Some(WStepName::Theorem49) => WStep::Theorem49,
                 Some(WStepName::Exploring) => WStep::Exploring,

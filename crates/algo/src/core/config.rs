@@ -7,7 +7,7 @@ use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
-use crate::core::options::{SepgOptions, WDirection};
+use crate::core::options::{SepgOptions, VDirection, WDirection};
 use crate::core::state::State;
 use crate::core::statement::Statement;
 
@@ -445,6 +445,38 @@ impl CheckedConfig {
         self
     }
 
+    /// The same configuration with the penalty coefficients c and d of `family`
+    /// (`sepg_bounds::penalties::Family`; the thesis's unless set): every bound and
+    /// certified step of the run follows it.
+    ///
+    /// # Errors
+    /// [`ConfigError::Environment`] when the family is rejected (a horizon of 0 steps);
+    /// [`ConfigError::UnsupportedOption`] for the Adam v-direction with the thesis's constants
+    /// ([`check_v_direction`]).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+    /// use sepg_algo::core::options::{SepgOptions, VDirection};
+    /// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+    /// use sepg_mdp::env::Preset;
+    /// let mut cfg = SepgConfig::new(Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Mi));
+    /// cfg.options.v_direction = VDirection::adam(1e-2);
+    /// let checked = cfg.check()?;
+    /// let tight = Family::Tight(Tight::new(Horizon::Finite(20), Rewards::NonPositive));
+    /// assert!(checked.clone().with_family(tight).is_ok());
+    /// assert!(checked.with_family(Family::Thesis).is_err());
+    /// # Ok::<(), sepg_algo::core::error::ConfigError>(())
+    /// ```
+    pub fn with_family(mut self, family: sepg_bounds::Family) -> Result<Self, ConfigError> {
+        self.constants = self
+            .constants
+            .with_family(family)
+            .map_err(|e| ConfigError::Environment(e.to_string()))?;
+        check_v_direction(&self.inner.options, &self.constants)?;
+        Ok(self)
+    }
+
     /// What a run of this configuration promises about exact J, and how firmly
     /// (docs/THEOREMS.md, "Statements over a whole run").
     ///
@@ -479,6 +511,29 @@ impl CheckedConfig {
             self.inner.initial_budget,
         )
     }
+}
+
+/// Checks that the v-direction of `options` is proven with the family of `constants`: the
+/// Adam v-direction steps along non-coordinate directions, for which only the tight constants
+/// are proven (docs/THEOREMS.md, "A step along any direction"; the thesis's c is proven for the
+/// greedy coordinate only).
+///
+/// # Errors
+/// [`ConfigError::UnsupportedOption`] for the Adam v-direction with the thesis's constants.
+pub fn check_v_direction(
+    options: &SepgOptions,
+    constants: &TaskConstants,
+) -> Result<(), ConfigError> {
+    if matches!(options.v_direction, VDirection::Adam { .. })
+        && constants.family() == sepg_bounds::Family::Thesis
+    {
+        return Err(ConfigError::UnsupportedOption {
+            option: "v_direction",
+            reason: "the Adam v-direction needs the tight constants (Theorem T): the thesis's \
+                     c is proven for the greedy coordinate only",
+        });
+    }
+    Ok(())
 }
 
 /// Checks the sampled-mode settings: δ ∈ (0, 1) and N large enough to give every block at

@@ -13,6 +13,7 @@
 //! | [`SepgOptions::overrides`] | none | γ = 0.9 in its script, ψ = 0.53 in d |
 //! | [`SepgOptions::accounting`] | [`Accounting::Certified`] | [`Accounting::Estimated`] |
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
+//! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
@@ -120,6 +121,54 @@ impl Accounting {
     }
 }
 
+/// The direction of the v-update.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum VDirection {
+    /// The greedy coordinate of Theorem 4.2 / eq. (4.11): the coordinate of the largest
+    /// |∇̂_{v_k}J|, with the largest safe step along it.
+    #[default]
+    Greedy,
+    /// "Safe Adam": Adam (Kingma and Ba 2015) proposes the change u from its moments of the
+    /// v-gradient estimates, and the applied change is t·u with t = min(1, the largest t whose
+    /// bound along u meets the v-block's requirement) (`sepg_bounds::direction`,
+    /// docs/THEOREMS.md "A step along any direction"): never longer than Adam's own change.
+    /// Proven with the tight constants only (Theorem T); the certified accounting only.
+    Adam {
+        /// Learning rate (> 0, units of v per step).
+        lr: f64,
+        /// First-moment decay β₁ ∈ [0, 1).
+        beta1: f64,
+        /// Second-moment decay β₂ ∈ [0, 1).
+        beta2: f64,
+        /// Denominator offset ε > 0 (units of ∇_vJ).
+        eps: f64,
+    },
+}
+
+impl VDirection {
+    /// Adam with the usual defaults β₁ = 0.9, β₂ = 0.999, ε = 1e-8 and learning rate `lr`.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::VDirection;
+    /// assert!(matches!(VDirection::adam(1e-2), VDirection::Adam { beta2, .. } if beta2 == 0.999));
+    /// ```
+    pub fn adam(lr: f64) -> Self {
+        VDirection::Adam {
+            lr,
+            beta1: 0.9,
+            beta2: 0.999,
+            eps: 1e-8,
+        }
+    }
+
+    /// Whether this is the default greedy coordinate (not written to summaries, so that
+    /// they read as before the option existed).
+    pub fn is_greedy(&self) -> bool {
+        *self == VDirection::Greedy
+    }
+}
+
 /// How the confidence δ is spread over the confidence statements of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Schedule {
@@ -196,6 +245,9 @@ pub struct SepgOptions {
     /// How δ is spread over the run's confidence statements.
     #[serde(default = "Schedule::legacy")]
     pub schedule: Schedule,
+    /// The direction of the v-update.
+    #[serde(default, skip_serializing_if = "VDirection::is_greedy")]
+    pub v_direction: VDirection,
 }
 
 impl Default for SepgOptions {
@@ -210,6 +262,7 @@ impl Default for SepgOptions {
             overrides: ConstantOverrides::default(),
             accounting: Accounting::Certified,
             schedule: Schedule::Run,
+            v_direction: VDirection::Greedy,
         }
     }
 }
@@ -238,8 +291,10 @@ impl SepgOptions {
     ///
     /// # Errors
     /// [`ConfigError::InvalidHyperParameter`] for a quantile factor that is not finite and
-    /// positive, a clipping threshold that is not finite and positive, or a reference batch
-    /// of 1 trajectory (a width needs 2).
+    /// positive, a clipping threshold that is not finite and positive, a reference batch
+    /// of 1 trajectory (a width needs 2), or Adam's hyper-parameters out of their domains;
+    /// [`ConfigError::UnsupportedOption`] for alternating iterations or the Adam v-direction
+    /// with the certified, resp. estimated, accounting.
     ///
     /// # Examples
     /// ```
@@ -271,6 +326,32 @@ impl SepgOptions {
         }
         if self.reference_batch == 1 {
             return Err(bad("reference batch", 1.0, "0 or at least 2"));
+        }
+        if let VDirection::Adam {
+            lr,
+            beta1,
+            beta2,
+            eps,
+        } = self.v_direction
+        {
+            let unit = |x: f64| (0.0..1.0).contains(&x);
+            for (name, value, ok, domain) in [
+                ("adam lr", lr, lr > 0.0, "(0, inf)"),
+                ("adam beta1", beta1, unit(beta1), "[0, 1)"),
+                ("adam beta2", beta2, unit(beta2), "[0, 1)"),
+                ("adam eps", eps, eps > 0.0, "(0, inf)"),
+            ] {
+                if !(ok && value.is_finite()) {
+                    return Err(bad(name, value, domain));
+                }
+            }
+            if self.accounting == Accounting::Estimated {
+                return Err(ConfigError::UnsupportedOption {
+                    option: "v_direction",
+                    reason: "the Adam v-direction is certified at its realised change: it needs \
+                             the certified accounting",
+                });
+            }
         }
         Ok(())
     }

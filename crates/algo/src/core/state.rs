@@ -35,6 +35,10 @@ pub struct State {
     /// Step size α of the latest v-update (the metagradient w-direction uses it).
     #[serde(default)]
     pub last_alpha: Option<f64>,
+    /// Adam moments of v for SEPG's Adam v-direction (`VDirection::Adam`), from the first
+    /// v-update on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adam_v: Option<AdamMoments>,
 }
 
 impl State {
@@ -61,6 +65,7 @@ impl State {
             trajectories: 0,
             steps: 0,
             last_alpha: None,
+            adam_v: None,
         }
     }
 

@@ -235,6 +235,17 @@ fn assumption_reasons(checked: &CheckedConfig) -> Vec<String> {
     {
         reasons.push("scores at the clipped action: the estimators are biased".to_string());
     }
+    if matches!(
+        cfg.options.v_direction,
+        crate::core::options::VDirection::Adam { .. }
+    ) && checked.constants().family() == sepg_bounds::Family::Thesis
+    {
+        reasons.push(
+            "the Adam v-direction with the thesis's constants: their c is proven for the \
+             greedy coordinate only (Theorem T proves the tight c for every direction)"
+                .to_string(),
+        );
+    }
     if matches!(cfg.env, sepg_mdp::env::AnyEnv::MountainCar(_)) {
         reasons.push(
             "Mountain Car's reward −0.1a² with the raw action is not bounded by R \

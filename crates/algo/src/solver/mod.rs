@@ -34,7 +34,9 @@ use sepg_estimators::proven::ProvenWidths;
 use sepg_mdp::env::{AnyEnv, Environment};
 use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 
-use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, check_sampled};
+use crate::core::config::{
+    Algorithm, CheckedConfig, GradientMode, Requirement, check_sampled, check_v_direction,
+};
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
 use crate::core::options::{Confidence, Schedule, SepgOptions, WStep};
@@ -69,7 +71,9 @@ impl PolicySolver {
     /// clipped-LQG dynamic programme (scalar clipped LQG) or the closed form (unclipped LQG).
     ///
     /// # Errors
-    /// [`ConfigError::ExactUnsupported`] when the exact oracle cannot be built for the model.
+    /// [`ConfigError::ExactUnsupported`] when the exact oracle cannot be built for the model;
+    /// [`ConfigError::UnsupportedOption`] for the Adam v-direction with the thesis's constants
+    /// (see [`CheckedConfig::with_family`]).
     ///
     /// # Examples
     /// See the [module documentation](self).
@@ -117,6 +121,7 @@ impl PolicySolver {
                 ))
             }
         };
+        check_v_direction(&cfg.options, &constants)?;
         let mut options = cfg.options;
         if cfg.gradient == GradientMode::Exact {
             // Exact J(θ⁰) needs no reference batch.
@@ -241,6 +246,7 @@ impl PolicySolver {
     /// than the solver's (its widths are built for it).
     pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
         options.validate()?;
+        check_v_direction(&options, &self.constants)?;
         if options.schedule != self.options.schedule
             || options.confidence != self.options.confidence
         {
@@ -330,6 +336,7 @@ impl Solver for PolicySolver {
                     n: self.n,
                     opts: &self.options,
                     certify: self.certified,
+                    features: self.dims.0 / self.dims.1.max(1),
                 };
                 sepg::iterate(&mut *self.source, &setup, state)
             }

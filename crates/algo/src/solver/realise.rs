@@ -26,6 +26,7 @@
 //! from the thesis form by the Θ(Δ³) terms Theorem 4.3 neglects (docs/ERRATA.md §10).
 use sepg_bounds::BoundsError;
 use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::direction::Direction;
 use sepg_bounds::rigorous;
 use sepg_certified::{self as certified, EnclosedBound, Interval, RigorousEnclosure};
 
@@ -130,6 +131,111 @@ impl CoordinateBound {
                 rigorous.enclose(delta) - d.abs().scale(eps)
             }
         }
+    }
+}
+
+/// Theorem T's bound of a change Δ of the mean parameters (module docs), valid for every Δ
+/// whose non-zero entries are among those of the direction it was built for, on the
+/// confidence event of every component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionalBound {
+    grad: Vec<f64>,
+    eps: Vec<f64>,
+    c2: Interval,
+}
+
+impl DirectionalBound {
+    /// The bound for the direction `d` (its estimate ĝ ± ε and feature norm) at standard
+    /// deviation `sigma` > 0, the smallest σ of the policy: c₂ = c_ℝ(σ)·κ_φ enclosed.
+    ///
+    /// # Errors
+    /// An invalid direction, σ not finite and positive, a non-coordinate direction with the
+    /// thesis's constants (`BoundsError::UnprovenDirection`).
+    pub fn new(k: &TaskConstants, sigma: f64, d: &Direction) -> Result<Self, BoundsError> {
+        d.validate()?;
+        let kappa = certified::enclosure::feature_factor(k, d)?;
+        Ok(DirectionalBound {
+            grad: d.grad_hat.to_vec(),
+            eps: d.eps.to_vec(),
+            c2: c_real_line(k, sigma)? * kappa,
+        })
+    }
+
+    /// An enclosure of the bound at the exact change `delta` (units of v; the length of the
+    /// direction, extra entries ignored).
+    pub fn enclose(&self, delta: &[f64]) -> Interval {
+        let zero = Interval::point(0.0);
+        let (mut linear, mut norm2) = (zero, zero);
+        for ((&d, &g), &e) in delta.iter().zip(&self.grad).zip(&self.eps) {
+            let d = Interval::point(d);
+            linear = linear + d.scale(g) - d.abs().scale(e);
+            norm2 = norm2 + d.sqr();
+        }
+        linear - self.c2 * norm2
+    }
+}
+
+/// The update of several coordinates that is applied, and the certified lower end of its
+/// bound.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealisedChange {
+    /// The new values of the coordinates.
+    pub values: Vec<f64>,
+    /// The step t·f along the direction that was applied (f the shrink factor; 0 for no
+    /// change).
+    pub step: f64,
+    /// The lower end of the enclosure of the bound at the realised change.
+    pub guaranteed: f64,
+    /// Whether the realised change meets the requirement (`guaranteed ≥ required`).
+    pub meets: bool,
+}
+
+/// Applies x₀ → fl(x₀ + t·u) coordinate by coordinate and certifies the realised change
+/// (exact by TwoSum in every coordinate) against `bound` for `required`; as [`realise`], a
+/// change that falls short is shrunk (t·(1 − 2⁻ʲ) for j = 52, …, 1) until one passes, no
+/// change being the last resort, and with `shrink` false the rounded update is kept and only
+/// its guarantee evaluated.
+pub fn realise_along(
+    x0: &[f64],
+    u: &[f64],
+    t: f64,
+    bound: &DirectionalBound,
+    required: f64,
+    shrink: bool,
+) -> RealisedChange {
+    let check = |factor: f64| -> Option<RealisedChange> {
+        let step = t * factor;
+        let values: Vec<f64> = x0.iter().zip(u).map(|(&x, &ui)| x + step * ui).collect();
+        let delta = values
+            .iter()
+            .zip(x0)
+            .map(|(&y, &x)| exact_difference(y, x))
+            .collect::<Option<Vec<f64>>>()?;
+        let lo = bound.enclose(&delta).lo();
+        (lo.is_finite() && (!shrink || lo >= required)).then_some(RealisedChange {
+            values,
+            step,
+            guaranteed: lo,
+            meets: lo >= required,
+        })
+    };
+    if t > 0.0 {
+        if let Some(r) = check(1.0) {
+            return r;
+        }
+        if shrink {
+            for j in (1..=52).rev() {
+                if let Some(r) = check(1.0 - (-(j as f64)).exp2()) {
+                    return r;
+                }
+            }
+        }
+    }
+    RealisedChange {
+        values: x0.to_vec(),
+        step: 0.0,
+        guaranteed: 0.0,
+        meets: required <= 0.0,
     }
 }
 
@@ -253,6 +359,49 @@ mod tests {
         // with a requirement no change can meet, nothing moves
         let none = realise(x0, delta, &b, 1e9, true);
         assert_eq!((none.value, none.guaranteed, none.meets), (x0, 0.0, false));
+    }
+
+    /// A change of two coordinates aimed at the boundary of Theorem T's bound is shrunk until
+    /// its realised change, exact in both coordinates, passes; c₂ = c·p for p = 2 features.
+    #[test]
+    fn a_failing_change_of_several_coordinates_is_shrunk_until_it_passes() {
+        use sepg_bounds::direction::FeatureNorm;
+        use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+        let k = lqg1d()
+            .with_family(Family::Tight(Tight::new(
+                Horizon::Finite(20),
+                Rewards::NonPositive,
+            )))
+            .expect("tight");
+        let (g, eps, u) = ([3.0, -1.0], [0.5, 0.25], [0.3, -0.7]);
+        let d = Direction {
+            direction: &u,
+            grad_hat: &g,
+            eps: &eps,
+            features: FeatureNorm::FromMax { features: 2 },
+        };
+        let b = DirectionalBound::new(&k, 1.0, &d).expect("bound");
+        let c2 = 2.0 * sepg_bounds::constants::c(&k, 1.0).expect("c");
+        // B(t) = t·a − c₂t²‖u‖² with a = u·g − Σ|u_i|ε_i: zero at t = a/(c₂‖u‖²)
+        let a = 0.3 * 3.0 + 0.7 - (0.3 * 0.5 + 0.7 * 0.25);
+        let t = a / (c2 * (0.09 + 0.49));
+        let x0 = [-0.1, 0.37];
+        let r = realise_along(&x0, &u, t, &b, 0.0, true);
+        assert!(r.meets && r.guaranteed >= 0.0 && r.step > 0.0 && r.step <= t);
+        let delta: Vec<f64> = r
+            .values
+            .iter()
+            .zip(&x0)
+            .map(|(&y, &x)| exact_difference(y, x).expect("exact"))
+            .collect();
+        assert!(b.enclose(&delta).lo() >= 0.0);
+        assert!(r.step >= t * (1.0 - 1e-9));
+        // a requirement no change meets leaves x₀ unchanged
+        let none = realise_along(&x0, &u, t, &b, 1e9, true);
+        assert_eq!(
+            (none.values, none.step, none.meets),
+            (x0.to_vec(), 0.0, false)
+        );
     }
 
     /// The log-σ bound is below the thesis form for Δ < 0 (the neglected terms) and the

@@ -1,15 +1,19 @@
 //! One iteration of SEPG (Algorithm 4.3 with the delayed budget updates of Sec 4.4.4).
+use crate::core::adam::AdamMoments;
 use crate::core::config::Requirement;
 use crate::core::error::RunError;
-use crate::core::options::{Accounting, Lb1Requirement, SepgOptions};
+use crate::core::options::{Accounting, Lb1Requirement, SepgOptions, VDirection};
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
 use sepg_bounds::budget::{Budget, split_requirement};
 use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::direction::{Direction, DirectionBound, FeatureNorm};
+use sepg_bounds::outcome::StepOutcome;
+use sepg_certified::Certified;
 
-use crate::solver::realise::{CoordinateBound, realise};
-use crate::solver::source::{Estimate, GradientSource, Need, Query};
+use crate::solver::realise::{CoordinateBound, DirectionalBound, realise, realise_along};
+use crate::solver::source::{Estimate, Grad, GradientSource, Need, Query};
 use crate::solver::steps::{self, Plan};
 
 /// Trajectories of each block: `n` split evenly, the remainder going to the first blocks.
@@ -74,6 +78,10 @@ pub(crate) struct Setup<'a> {
     pub(crate) opts: &'a SepgOptions,
     /// Certified steps (`sepg_certified`).
     pub(crate) certify: bool,
+    /// p, the number of features of one action (the v-space of one action has p
+    /// components): the feature 2-norm of a step along a non-coordinate direction is bounded
+    /// by √p·M_φ.
+    pub(crate) features: usize,
 }
 
 /// The v-update of a block whose estimate `e` holds ∇_v J, from (`v`, `w`) for `required`:
@@ -296,6 +304,7 @@ pub(crate) fn iterate(
         n,
         opts,
         certify,
+        ..
     } = *setup;
     if opts.accounting == Accounting::Certified {
         return iterate_certified(source, setup, state);
@@ -639,6 +648,77 @@ fn apply_realised(
     Ok((log, r.guaranteed, size))
 }
 
+/// The v-update along the proposed direction `u` (SEPG's Adam v-direction): the largest
+/// step t ∈ [0, 1] whose bound along u meets `required` (certified when `setup.certify`), the
+/// change t·u realised and certified again (`realise_along`). Returns the block log, the
+/// guaranteed improvement of the applied change and the t applied (0 for no change).
+fn along_direction(
+    setup: &Setup,
+    sigma: f64,
+    grad: &Grad,
+    u: &[f64],
+    required: f64,
+    v: &mut [f64],
+) -> Result<(BlockLog, f64, f64), RunError> {
+    let be = |e: sepg_bounds::BoundsError| RunError::Bounds(e.to_string());
+    if u.iter().all(|&x| x == 0.0) {
+        // Adam proposes no change (every gradient so far exactly 0)
+        let log = BlockLog {
+            below_noise: true,
+            ..BlockLog::default()
+        };
+        return Ok((log, 0.0, 0.0));
+    }
+    let d = Direction {
+        direction: u,
+        grad_hat: &grad.value,
+        eps: &grad.eps,
+        features: FeatureNorm::FromMax {
+            features: setup.features,
+        },
+    };
+    if !setup.certify {
+        let s = DirectionBound::new(setup.k, sigma, &d)
+            .and_then(|b| b.safe_step(required, 1.0))
+            .map_err(be)?;
+        for (x, &ui) in v.iter_mut().zip(u) {
+            *x += s.step * ui;
+        }
+        let (lambda, infeasible) = match s.outcome {
+            StepOutcome::Feasible(i) => (i.lambda, false),
+            _ => (Some(0.0), true),
+        };
+        let log = BlockLog {
+            size: s.step,
+            lambda,
+            guaranteed: Some(s.guaranteed),
+            infeasible,
+            below_noise: false,
+            certified: None,
+        };
+        return Ok((log, s.guaranteed, s.step));
+    }
+    let outcome =
+        sepg_certified::direction_safe_step(setup.k, sigma, &d, required, 1.0).map_err(be)?;
+    let (lambda, infeasible) = match outcome {
+        Certified::Step(s) => (s.interval.lambda, false),
+        _ => (Some(0.0), true),
+    };
+    let bound = DirectionalBound::new(setup.k, sigma, &d).map_err(be)?;
+    let t = outcome.chosen_step().unwrap_or(0.0);
+    let r = realise_along(v, u, t, &bound, required, outcome.is_certified());
+    v.copy_from_slice(&r.values);
+    let log = BlockLog {
+        size: r.step,
+        lambda,
+        guaranteed: Some(r.guaranteed),
+        infeasible,
+        below_noise: false,
+        certified: Some(r.meets && outcome.is_certified()),
+    };
+    Ok((log, r.guaranteed, r.step))
+}
+
 /// ε = max_i ε_i of a gradient.
 fn eps_max(g: &crate::solver::source::Grad) -> f64 {
     g.eps.iter().fold(0.0, |m: f64, &e| m.max(e))
@@ -665,6 +745,7 @@ fn iterate_certified(
         n,
         opts,
         certify,
+        ..
     } = *setup;
     let t = state.iteration;
     let sizes = split(n, req.blocks());
@@ -702,17 +783,33 @@ fn iterate_certified(
         "the v-block returned no gradient".into(),
     ))?;
     let sigma_v = min_sigma(&state.w);
-    let v_plan = steps::v_step(k, sigma_v, grad_v, required_v, certify)?;
     let mut v_new = state.v.clone();
-    let eps_v = eps_max(grad_v);
     let bounds = |e: sepg_bounds::BoundsError| RunError::Bounds(e.to_string());
-    let (v_log, g_v, alpha) = apply_realised(
-        &mut v_new,
-        &v_plan,
-        |i| CoordinateBound::mean(k, sigma_v, grad_v.value[i], eps_v).map_err(bounds),
-        required_v,
-        certify,
-    )?;
+    let (v_log, g_v, alpha) = match opts.v_direction {
+        VDirection::Greedy => {
+            let v_plan = steps::v_step(k, sigma_v, grad_v, required_v, certify)?;
+            let eps_v = eps_max(grad_v);
+            apply_realised(
+                &mut v_new,
+                &v_plan,
+                |i| CoordinateBound::mean(k, sigma_v, grad_v.value[i], eps_v).map_err(bounds),
+                required_v,
+                certify,
+            )?
+        }
+        VDirection::Adam {
+            lr,
+            beta1,
+            beta2,
+            eps,
+        } => {
+            let moments = state
+                .adam_v
+                .get_or_insert_with(|| AdamMoments::zeros(grad_v.value.len()));
+            let u = moments.step(&grad_v.value, lr, beta1, beta2, eps);
+            along_direction(setup, sigma_v, grad_v, &u, required_v, &mut v_new)?
+        }
+    };
     let b1 = add_down(b0, g_v);
 
     let sigmas = state.sigma();

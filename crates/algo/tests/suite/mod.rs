@@ -8,6 +8,7 @@ mod exact;
 mod mountain_car;
 mod options;
 mod plumbing;
+mod safe_adam;
 mod safety;
 mod sampled;
 mod score_action;

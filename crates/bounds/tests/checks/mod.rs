@@ -5,6 +5,7 @@ mod batch_size;
 mod budget;
 mod common;
 mod constants;
+mod direction;
 mod error;
 mod exploring;
 mod high_probability;

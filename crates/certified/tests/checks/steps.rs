@@ -121,3 +121,70 @@ fn tight_constants_are_certified_by_enclosure() {
         }
     }
 }
+
+/// The certified step along a direction: never beyond the `f64` step nor the cap, its
+/// enclosure meets C, the enclosure contains the `f64` bound at that step, and it is within
+/// 1e-12 (relative) of the `f64` step, over a fixed grid of directions, widths and
+/// requirements with the tight constants.
+#[test]
+fn direction_steps_are_certified_and_close_to_the_f64_step() {
+    use sepg_bounds::direction::{Direction, DirectionBound, FeatureNorm};
+    use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+    let k = TaskConstants::new(0.99, 28.8, 4.0, 8.0)
+        .and_then(|k| {
+            k.with_family(Family::Tight(Tight::new(
+                Horizon::Finite(20),
+                Rewards::NonPositive,
+            )))
+        })
+        .expect("constants");
+    let mut n = 0;
+    for (i, u) in [[1e-2, -3e-3], [0.0, 0.7], [-1e-4, -1e-4]]
+        .iter()
+        .enumerate()
+    {
+        for g in [[35.0, -4.0], [-0.3, 0.2], [1e-3, 12.0]] {
+            for e in [0.0, 0.1, 3.0] {
+                for sigma in [0.1, 0.5, 1.0] {
+                    let d = Direction {
+                        direction: u,
+                        grad_hat: &g,
+                        eps: &[e, e],
+                        features: FeatureNorm::FromMax { features: 2 + i },
+                    };
+                    let b = DirectionBound::new(&k, sigma, &d).expect("bound");
+                    // C_max over t ≥ 0: 0 when the direction does not ascend the bound
+                    let c_max = if b.parabola.linear > 0.0 {
+                        b.parabola.c_max().expect("c_max")
+                    } else {
+                        0.0
+                    };
+                    for (required, cap) in [
+                        (0.0, 1.0),
+                        (0.0, f64::INFINITY),
+                        (-1e-3, 1.0),
+                        (0.5 * c_max, f64::INFINITY),
+                    ] {
+                        let f = b.safe_step(required, cap).expect("f64 step");
+                        let o = sepg_certified::direction_safe_step(&k, sigma, &d, required, cap)
+                            .expect("certified");
+                        let Certified::Step(s) = o else {
+                            panic!("{u:?} {g:?} {e} {sigma} {required}: {o:?}")
+                        };
+                        assert!(s.step <= f.step && s.step <= cap && s.step >= 0.0);
+                        assert!(s.bound.lo() >= required);
+                        assert!(s.bound.contains(b.bound(s.step).expect("bound")));
+                        assert!(
+                            f.step - s.step <= 1e-12 * f.step,
+                            "{} vs {}",
+                            s.step,
+                            f.step
+                        );
+                        n += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(n, 324);
+}
