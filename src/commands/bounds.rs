@@ -62,7 +62,7 @@ pub struct BoundsArgs {
     eps: Option<f64>,
     /// Horizon H ≥ 1 (or `inf`): of the tight constants, and of the Chebyshev batch sizes
     /// (finite there).
-    #[arg(long, value_parser = parse_horizon)]
+    #[arg(long, value_parser = parse_horizon, allow_hyphen_values = true)]
     horizon: Option<Horizon>,
     /// Family of the constants c and d: the thesis's (Theorems 3.14, 4.2, 4.3) or the tight
     /// constants c = ρRM_φ²S_H/σ², d = 2ρRS_H (docs/THEOREMS.md, "Tight constants"), which
