@@ -63,19 +63,28 @@ def test_an_infinite_horizon_and_bad_values():
 
 
 def collector(req):
-    """Trajectories of two steps, reward 1, feature 1, action 0: every trajectory alike, so
-    the Student-t widths are 0 and the step is 1/c times the gradient's (Theorem 4.2, C = 0)."""
+    """Trajectories of two steps with feature 1 and the policy's actions, reward clip(a, -1, 1):
+    the data depend only on the request, so two trainers asked for the same batch get the same
+    one."""
     n = req.n
-    return np.ones((n, 2)), np.zeros((n, 2, 1)), np.ones((n, 2, 1)), np.full(n, 2)
+    rng = np.random.default_rng([req.iteration, len(req.block), n])
+    mean = float(np.asarray(req.mean)[0, 0])
+    sigma = 0.0 if req.sigma is None else float(req.sigma[0])
+    actions = mean + sigma * rng.standard_normal((n, 2, 1))
+    rewards = np.clip(actions[:, :, 0], -1.0, 1.0)
+    return rewards, actions, np.ones((n, 2, 1)), np.full(n, 2)
 
 
 def test_a_trainer_step_with_tight_constants_is_larger_by_the_ratio_of_c():
+    # SEPG-MI's first v-step (C = 0) is the high-probability step of Theorem 4.7,
+    # (||g||^-)^2 / (c (||g||^+)^2): the same batch under both families, so the steps differ by
+    # the ratio of the two c only.
     gamma, r, m, vol, sigma = 0.9, 1.0, 1.0, 2.0, 1.0
     thesis = sepg.TaskConstants(gamma, r, m, vol)
     tight = thesis.with_family("tight", horizon=2)
     steps = {}
     for name, k in [("thesis", thesis), ("tight", tight)]:
-        trainer = sepg.Trainer("sepg-mi", k, 1, 1, collector, n_trajectories=12)
+        trainer = sepg.Trainer("sepg-mi", k, 1, 1, collector, n_trajectories=400)
         steps[name] = json.loads(trainer.run(1))[0]["alpha"]
     c_thesis = thesis_c(gamma, r, m, vol, sigma)
     c_tight = r * m * m * s_h_closed(gamma, 2) / sigma**2  # S_2 = 1 + 2 gamma

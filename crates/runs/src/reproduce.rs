@@ -572,4 +572,66 @@ mod tests {
             assert_eq!((v.alternating, v.lb1_requirement), (None, None));
         }
     }
+
+    /// The thesis's settings keep the thesis's constants for every variant; the default
+    /// setting leaves the key to the runs' default (tight), and `--constants` overrides both.
+    #[test]
+    fn thesis_settings_keep_the_thesis_constants_and_the_default_takes_tight() {
+        let one = crate::sweep::Shard { index: 0, count: 1 };
+        for setting in [
+            Setting::ThesisCode,
+            Setting::PotionLiteral,
+            Setting::NoConfidence,
+        ] {
+            let opts = ReproduceOptions {
+                setting,
+                preset: Some(LqgPreset::Lqg1d),
+                seeds: 1,
+                ..ReproduceOptions::new(Experiment::Table51)
+            };
+            let spec = sweep_spec(&opts).expect("valid");
+            assert!(
+                spec.variant
+                    .iter()
+                    .all(|v| v.constants == Some(ConstantsName::Thesis))
+            );
+            let (_, resolved) = crate::sweep::expand(&spec, one).expect("resolves");
+            assert!(
+                resolved
+                    .iter()
+                    .all(|r| r.checked.constants().family()
+                        == sepg_bounds::penalties::Family::Thesis)
+            );
+        }
+        let default = ReproduceOptions {
+            preset: Some(LqgPreset::Lqg1d),
+            seeds: 1,
+            ..ReproduceOptions::new(Experiment::Table51)
+        };
+        let spec = sweep_spec(&default).expect("valid");
+        assert!(spec.variant.iter().all(|v| v.constants.is_none()));
+        let (_, resolved) = crate::sweep::expand(&spec, one).expect("resolves");
+        let tight = sepg_bounds::penalties::Family::Tight(sepg_bounds::penalties::Tight::new(
+            sepg_bounds::penalties::Horizon::Finite(20),
+            sepg_bounds::penalties::Rewards::NonPositive,
+        ));
+        assert!(
+            resolved
+                .iter()
+                .all(|r| r.checked.constants().family() == tight)
+        );
+        let thesis = ReproduceOptions {
+            flags: OptionFlags {
+                constants: Some(ConstantsName::Thesis),
+                ..OptionFlags::default()
+            },
+            ..default
+        };
+        let spec = sweep_spec(&thesis).expect("valid");
+        assert!(
+            spec.variant
+                .iter()
+                .all(|v| v.constants == Some(ConstantsName::Thesis))
+        );
+    }
 }

@@ -1463,6 +1463,64 @@ mod tests {
         }
     }
 
+    /// The constants family: tight by default with the preset's reward sign and the run's
+    /// horizon, the thesis's on request; `rewards` only with the tight family, and
+    /// non-positive refused on Mountain Car; every choice survives config.toml.
+    #[test]
+    fn the_constants_family_resolves_and_round_trips() {
+        use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+        let tight = |h, r| Family::Tight(Tight::new(Horizon::Finite(h), r));
+        let cases = [
+            (RunSpec::default(), tight(20, Rewards::NonPositive)),
+            (
+                RunSpec {
+                    env: Some(EnvName::MountainCar),
+                    horizon: Some(30),
+                    ..RunSpec::default()
+                },
+                tight(30, Rewards::TwoSided),
+            ),
+            (
+                RunSpec {
+                    rewards: Some(RewardsName::TwoSided),
+                    algo: Some(AlgoName::Adastep),
+                    ..RunSpec::default()
+                },
+                tight(20, Rewards::TwoSided),
+            ),
+            (
+                RunSpec {
+                    constants: Some(ConstantsName::Thesis),
+                    r_max: Some(3.0),
+                    ..RunSpec::default()
+                },
+                Family::Thesis,
+            ),
+        ];
+        for (spec, family) in cases {
+            let once = spec.resolve().expect("valid");
+            assert_eq!(once.checked.constants().family(), family, "{spec:?}");
+            let again: RunSpec = toml::from_str(&once.toml().expect("toml")).expect("parse");
+            let twice = again.resolve().expect("valid");
+            assert_eq!(once.spec, twice.spec);
+            assert_eq!(once.checked, twice.checked);
+        }
+        for bad in [
+            RunSpec {
+                constants: Some(ConstantsName::Thesis),
+                rewards: Some(RewardsName::TwoSided),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                env: Some(EnvName::MountainCar),
+                rewards: Some(RewardsName::NonPositive),
+                ..RunSpec::default()
+            },
+        ] {
+            assert!(bad.resolve().is_err(), "{bad:?}");
+        }
+    }
+
     #[test]
     fn algorithm_names_are_the_configuration_names() {
         let all = [
