@@ -345,12 +345,14 @@ pub struct UsedConstants {
     /// S_H = Σ_{t<H} (t + 1) γᵗ of the tight constants; absent for the thesis's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub s_h: Option<f64>,
-    /// c(σ⁰_j) for each component of σ⁰ (empty in the summaries of older versions).
+    /// c(σ⁰_j) for each component of σ⁰, `None` where not representable (empty in the
+    /// summaries of older versions).
     #[serde(default)]
-    pub c_sigma0: Vec<f64>,
-    /// d(σ⁰_j) for each component of σ⁰ (empty in the summaries of older versions).
+    pub c_sigma0: Vec<Option<f64>>,
+    /// d(σ⁰_j) for each component of σ⁰, `None` where not representable (empty in the
+    /// summaries of older versions).
     #[serde(default)]
-    pub d_sigma0: Vec<f64>,
+    pub d_sigma0: Vec<Option<f64>>,
 }
 
 impl Default for UsedConstants {
@@ -372,11 +374,9 @@ impl Default for UsedConstants {
 }
 
 impl UsedConstants {
-    /// The constants of the resolved run `resolved`, with c and d at its σ⁰.
-    ///
-    /// # Errors
-    /// [`Error::Invalid`] when c or d at σ⁰ is not representable.
-    pub fn of(resolved: &Resolved) -> Result<Self> {
+    /// The constants of the resolved run `resolved`, with c and d at its σ⁰ (`None` where
+    /// one is not representable, σ⁰ extremely small).
+    pub fn of(resolved: &Resolved) -> Self {
         let k = resolved.checked.constants();
         let at = |f: fn(&TaskConstants, f64) -> std::result::Result<f64, BoundsError>| {
             resolved
@@ -384,8 +384,8 @@ impl UsedConstants {
                 .config()
                 .sigma0
                 .iter()
-                .map(|&s| f(k, s).map_err(|e| Error::invalid(format!("constants at sigma0: {e}"))))
-                .collect::<Result<Vec<f64>>>()
+                .map(|&s| f(k, s).ok())
+                .collect::<Vec<Option<f64>>>()
         };
         let (family, horizon, rewards, s_h) = match k.family() {
             Family::Tight(t) => (
@@ -402,7 +402,7 @@ impl UsedConstants {
             ),
             _ => (ConstantsName::Thesis, None, None, None),
         };
-        Ok(UsedConstants {
+        UsedConstants {
             gamma: k.gamma(),
             r_max: k.r_max(),
             m_phi: k.m_phi(),
@@ -412,9 +412,9 @@ impl UsedConstants {
             horizon,
             rewards,
             s_h,
-            c_sigma0: at(constants::c)?,
-            d_sigma0: at(constants::d)?,
-        })
+            c_sigma0: at(constants::c),
+            d_sigma0: at(constants::d),
+        }
     }
 }
 

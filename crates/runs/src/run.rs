@@ -301,7 +301,7 @@ fn finish(
         iterations_per_s: rate(s.iteration as f64),
         env_steps_per_s: rate(s.steps as f64),
         options: resolved.checked.config().options,
-        constants: UsedConstants::of(resolved)?,
+        constants: UsedConstants::of(resolved),
         scores: resolved.spec.scores,
         certified_steps: resolved.spec.certified_steps,
         statement: Some(resolved.checked.statement()),

@@ -1253,18 +1253,17 @@ pub struct Resolved {
 }
 
 impl Resolved {
-    /// The resolved configuration as TOML text.
+    /// The resolved configuration as TOML text. The options are followed by comment lines
+    /// that state the constants the bounds use: their family, and for the tight family its
+    /// horizon, reward sign and S_H, then c and d at σ⁰ (comments, so that reading the file
+    /// back sees the options only).
     ///
     /// # Errors
     /// [`Error::Failed`] if serialisation fails.
-    ///
-    /// The options are followed by comment lines that state the constants the bounds use:
-    /// their family, and for the tight family its horizon, reward sign and S_H, then c and d
-    /// at σ⁰ (comments, so that reading the file back sees the options only).
     pub fn toml(&self) -> Result<String> {
         let mut text = toml::to_string(&self.spec)
             .map_err(|e| Error::failed(format!("cannot serialise the configuration: {e}")))?;
-        let used = crate::folder::UsedConstants::of(self)?;
+        let used = crate::folder::UsedConstants::of(self);
         text.push_str(&format!(
             "# constants used by the bounds: {}",
             used.family.name()
@@ -1276,9 +1275,17 @@ impl Resolved {
             };
             text.push_str(&format!(", horizon {h}, rewards {sign}, S_H = {s_h:?}"));
         }
+        let list = |v: &[Option<f64>]| {
+            let items: Vec<String> = v
+                .iter()
+                .map(|x| x.map_or_else(|| "not representable".to_owned(), |x| format!("{x:?}")))
+                .collect();
+            format!("[{}]", items.join(", "))
+        };
         text.push_str(&format!(
-            "\n# c(sigma0) = {:?}\n# d(sigma0) = {:?}\n",
-            used.c_sigma0, used.d_sigma0
+            "\n# c(sigma0) = {}\n# d(sigma0) = {}\n",
+            list(&used.c_sigma0),
+            list(&used.d_sigma0)
         ));
         Ok(text)
     }
