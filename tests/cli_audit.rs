@@ -387,10 +387,17 @@ fn a_clean_run_holds_and_an_injected_drop_breaks_it_at_its_iteration() {
 fn each_check_breaks_when_its_own_requirement_is_broken() {
     let tmp = tempfile::tempdir().expect("tempdir");
     // the thesis's bookkeeping moves both blocks in every iteration (under the certified
-    // accounting an exact ZV run spends no budget on w); the statement is then set by hand
+    // accounting an exact ZV run spends no budget on w); the statement is then set by hand.
+    // With the thesis's constants: the tight constants' larger steps let ZV's estimated
+    // budget, which counts the target's gains, take J below J(θ⁰) by iteration 4, so the
+    // run would not be clean before a cell is changed.
     let certain = |name: &str, algo: &str| {
         let dir = tmp.path().join(name);
-        exact_run_with(&dir, algo, &["--accounting", "estimated"]);
+        exact_run_with(
+            &dir,
+            algo,
+            &["--accounting", "estimated", "--constants", "thesis"],
+        );
         set_statement(&dir, "proven", "run", None);
         dir
     };
@@ -470,14 +477,17 @@ fn reference_j(v: f64, w: f64) -> f64 {
 
 #[test]
 fn one_exact_violation_of_1e_9_near_convergence_breaks_a_run_level_statement() {
-    // Exact SEPG-MI on lqg1d from v⁰ = −0.6 (v* ≈ −0.6089 at σ = 1): v-steps of 4e-9, J
-    // changes of about 4e-9. Iteration 5's logged guarantee is set to the true change plus
-    // 1e-9 (or minus 1e-9), the true change from the finer reference DP.
+    // Exact SEPG-MI on lqg1d from v⁰ = −0.6 (v* ≈ −0.6089 at σ = 1) with the thesis's
+    // constants: v-steps of 4e-9, J changes of about 4e-9. Iteration 5's logged guarantee is
+    // set to the true change plus 1e-9 (or minus 1e-9), the true change from the finer
+    // reference DP.
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("mi");
     run(
         &dir,
         &[
+            "--constants",
+            "thesis",
             "--env",
             "lqg1d",
             "--algo",
@@ -1061,7 +1071,10 @@ fn help_documents_the_exit_statuses() {
 #[test]
 fn the_reviews_lb2_run_from_the_optimum() {
     let tmp = tempfile::tempdir().expect("tempdir");
+    // the review's case ran with the thesis's constants
     let start = [
+        "--constants",
+        "thesis",
         "--env",
         "lqg",
         "--algo",

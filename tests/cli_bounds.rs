@@ -264,3 +264,120 @@ fn certified_prints_enclosures_around_the_f64_values() {
     // without the flag there is no certified section
     assert!(run_json(&[]).get("certified").is_none());
 }
+
+/// S_H = Σ_{t<H} (t + 1)γᵗ in closed form, (1 − (H + 1)γ^H + Hγ^{H+1}) / (1 − γ)².
+fn s_h_closed(gamma: f64, h: i32) -> f64 {
+    (1.0 - f64::from(h + 1) * gamma.powi(h) + f64::from(h) * gamma.powi(h + 1))
+        / (1.0 - gamma).powi(2)
+}
+
+fn tight_json(sigma: &str, extra: &[&str]) -> serde_json::Value {
+    let mut args: Vec<&str> = BASE.to_vec();
+    args.extend_from_slice(&[sigma, "--constants", "tight"]);
+    args.extend_from_slice(extra);
+    args.push("--json");
+    json_ok(&sepg(&args))
+}
+
+/// The tight constants (docs/THEOREMS.md, "Tight constants"): c = ρRM_φ²S_H/σ² and
+/// d = 2ρRS_H, two-sided (ρ = 1) unless the rewards are stated non-positive (ρ = 1/2), with
+/// S_H from its closed form; the report names the family, S_H and ρ.
+#[test]
+fn tight_constants_match_the_closed_form_at_every_sigma() {
+    let (r, m) = (4.0, 2.0);
+    let s_h = s_h_closed(0.99, 20);
+    for sigma in ["0.05", "0.5", "1", "3.7"] {
+        let s: f64 = sigma.parse().expect("number");
+        let two = tight_json(sigma, &["--horizon", "20"]);
+        assert_eq!(two["constants"], "tight");
+        assert_eq!(two["rewards"], "two-sided");
+        assert_eq!(two["horizon"], "20");
+        assert!(close(get(&two, "s_h"), s_h, 1e-13));
+        assert_eq!(get(&two, "rho"), 1.0);
+        assert!(close(get(&two, "c"), r * m * m * s_h / (s * s), 1e-13));
+        assert!(close(get(&two, "d"), 2.0 * r * s_h, 1e-13));
+        assert!(close(
+            get(&two, "alpha_star"),
+            s * s / (2.0 * r * m * m * s_h),
+            1e-12
+        ));
+        let half = tight_json(sigma, &["--horizon", "20", "--rewards", "non-positive"]);
+        assert_eq!(half["rewards"], "non-positive");
+        assert_eq!(get(&half, "rho"), 0.5);
+        assert!(close(
+            get(&half, "c"),
+            0.5 * r * m * m * s_h / (s * s),
+            1e-13
+        ));
+        assert!(close(get(&half, "d"), r * s_h, 1e-13));
+    }
+    // H = ∞: S_∞ = 1/(1 − γ)².
+    let inf = tight_json("0.5", &["--horizon", "inf"]);
+    assert_eq!(inf["horizon"], "inf");
+    let s_inf = 1.0 / (0.01f64 * 0.01);
+    assert!(close(get(&inf, "s_h"), s_inf, 1e-12));
+    assert!(close(get(&inf, "d"), 2.0 * r * s_inf, 1e-12));
+    // H = 1: S_1 = 1, whatever γ.
+    let one = tight_json("0.5", &["--horizon", "1"]);
+    assert!(close(get(&one, "c"), r * m * m / 0.25, 1e-15));
+    // The thesis's family stays the default, and its report says so.
+    let thesis = run_json(&[]);
+    assert_eq!(thesis["constants"], "thesis");
+    assert!(thesis.get("s_h").is_none());
+}
+
+/// `--certified` with the tight constants encloses the closed-form c and d, and certifies
+/// the safe step of the tight penalty.
+#[test]
+fn certified_tight_constants_enclose_the_closed_form() {
+    let v = tight_json(
+        "0.5",
+        &[
+            "--horizon",
+            "20",
+            "--rewards",
+            "non-positive",
+            "--grad-v",
+            "0.3",
+            "--certified",
+        ],
+    );
+    let s_h = s_h_closed(0.99, 20);
+    let (c, d) = (0.5 * 4.0 * 4.0 * s_h / 0.25, 4.0 * s_h);
+    let enc = &v["certified"]["enclosures"];
+    let ends = |name: &str| {
+        [
+            enc[name][0].as_f64().expect("lo"),
+            enc[name][1].as_f64().expect("hi"),
+        ]
+    };
+    // The closed form is evaluated in f64 here: within 1e-13 relative of the enclosure.
+    for (name, value) in [("c", c), ("d", d)] {
+        let [lo, hi] = ends(name);
+        assert!(lo <= hi && lo <= value * (1.0 + 1e-13) && value <= hi * (1.0 + 1e-13));
+        assert!(hi - lo <= 1e-12 * value, "{name}: [{lo}, {hi}]");
+    }
+    let step = &v["certified"]["steps"]["alpha_bar"];
+    assert_eq!(step["outcome"], "certified");
+    // ᾱ = (1 + λ)/(2c) with λ = 1 at C = 0: 1/c.
+    assert!(close(step["step"].as_f64().expect("step"), 1.0 / c, 1e-12));
+}
+
+#[test]
+fn bad_constants_arguments_are_one_line_exit_2() {
+    let with = |extra: &[&str]| {
+        let mut args: Vec<&str> = BASE.to_vec();
+        args.push("0.5");
+        args.extend_from_slice(extra);
+        assert_usage_error(&sepg(&args))
+    };
+    assert!(with(&["--constants", "foo"]).contains("--constants"));
+    assert!(with(&["--constants", "tight", "--horizon", "0"]).contains("horizon"));
+    assert!(with(&["--constants", "tight", "--horizon", "-3"]).contains("horizon"));
+    assert!(with(&["--constants", "tight"]).contains("--horizon"));
+    assert!(with(&["--rewards", "non-positive"]).contains("--rewards"));
+    assert!(
+        with(&["--constants", "tight", "--horizon", "20", "--rewards", "up"]).contains("--rewards")
+    );
+    assert!(with(&["--horizon", "inf", "--delta", "0.1", "--eps", "0.1"]).contains("finite"));
+}

@@ -613,7 +613,8 @@ fn resuming_a_finished_run_says_so() {
     );
 }
 
-/// An exact-gradient SEPG-LV run with the thesis's bookkeeping on `lqg` from σ⁰ = 1 breaks
+/// An exact-gradient SEPG-LV run with the thesis's bookkeeping and constants on `lqg` from
+/// σ⁰ = 1 breaks
 /// its own budget (ERRATA §25: −8.6e-5 at iteration 531, computed by the clipped DP): the
 /// run says so on stderr and in summary.json's `self_check`, instead of ending silently.
 /// The same run with the certified accounting keeps its budget (no warning, not broken).
@@ -637,6 +638,9 @@ fn a_run_that_breaks_its_own_budget_says_so() {
             "--quiet",
             "--accounting",
             accounting,
+            // ERRATA §25 is a case of the thesis's w-bound
+            "--constants",
+            "thesis",
             "--out",
             out,
         ])
@@ -673,4 +677,201 @@ fn a_run_that_breaks_its_own_budget_says_so() {
     .expect("json");
     assert_eq!(summary["self_check"]["broken"], false);
     assert_eq!(summary["statement"]["kind"], "proven");
+}
+
+/// S_H = Σ_{t<H} (t + 1)γᵗ in closed form, (1 − (H + 1)γ^H + Hγ^{H+1}) / (1 − γ)².
+fn s_h_closed(gamma: f64, h: i32) -> f64 {
+    (1.0 - f64::from(h + 1) * gamma.powi(h) + f64::from(h) * gamma.powi(h + 1))
+        / (1.0 - gamma).powi(2)
+}
+
+fn rel_close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-13 * b.abs()
+}
+
+/// A short lqg1d run (σ⁰ = 0.5) with the extra flags; returns its folder's summary.json.
+fn short_lqg1d_run(dir: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "run",
+        "--env",
+        "lqg1d",
+        "--iterations",
+        "2",
+        "--batch",
+        "12",
+        "--sigma0",
+        "0.5",
+        "--quiet",
+        "--out",
+    ];
+    let d = dir.display().to_string();
+    args.push(&d);
+    args.extend_from_slice(extra);
+    sepg_ok(&args);
+    json(&dir.join("summary.json"))
+}
+
+/// The constants of `lqg1d`: R = 0.9 (4² + 4²) = 28.8 over S = A = [−4, 4], M_φ = 4.
+const LQG1D_R: f64 = 28.8;
+const LQG1D_M: f64 = 4.0;
+
+/// A default run takes the tight constants with the preset's reward sign (LQG rewards
+/// −0.9(s² + a²) ≤ 0, so ρ = 1/2) and the run's horizon, and records the family, horizon,
+/// sign, S_H and c, d at σ⁰ in summary.json and config.toml; an override of R keeps the
+/// family; `--constants thesis` records the thesis's c and d.
+#[test]
+fn a_default_run_records_the_tight_constants_it_used() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let s_h = s_h_closed(0.99, 20);
+    let sigma: f64 = 0.5;
+    let tight_c = |r: f64| 0.5 * r * LQG1D_M * LQG1D_M * s_h / (sigma * sigma);
+    let default = short_lqg1d_run(&tmp.path().join("default"), &[]);
+    let k = &default["constants"];
+    assert_eq!(k["family"], "tight");
+    assert_eq!(k["rewards"], "non-positive");
+    assert_eq!(k["horizon"].as_u64(), Some(20));
+    assert!(rel_close(k["s_h"].as_f64().expect("s_h"), s_h));
+    assert!(rel_close(
+        k["c_sigma0"][0].as_f64().expect("c"),
+        tight_c(LQG1D_R)
+    ));
+    assert!(rel_close(
+        k["d_sigma0"][0].as_f64().expect("d"),
+        LQG1D_R * s_h
+    ));
+    assert_eq!(
+        default["options"]["constants"]["Tight"]["rewards"],
+        "NonPositive"
+    );
+    let config = read(&tmp.path().join("default").join("config.toml"));
+    assert!(config.contains("constants = \"tight\""), "{config}");
+    assert!(config.contains("rewards = \"non-positive\""), "{config}");
+    assert!(config.contains("S_H = "), "{config}");
+
+    // An override of R keeps the family and enters c and d.
+    let r = short_lqg1d_run(&tmp.path().join("r-max"), &["--r-max", "10"]);
+    assert_eq!(r["constants"]["family"], "tight");
+    assert!(rel_close(
+        r["constants"]["c_sigma0"][0].as_f64().expect("c"),
+        tight_c(10.0)
+    ));
+    assert!(rel_close(
+        r["constants"]["d_sigma0"][0].as_f64().expect("d"),
+        10.0 * s_h
+    ));
+
+    // Two-sided by choice: ρ = 1.
+    let two = short_lqg1d_run(&tmp.path().join("two"), &["--rewards", "two-sided"]);
+    assert!(rel_close(
+        two["constants"]["d_sigma0"][0].as_f64().expect("d"),
+        2.0 * LQG1D_R * s_h
+    ));
+
+    // The thesis's constants (Theorems 4.2 and 4.3, |A| = 8), written out here.
+    let thesis = short_lqg1d_run(&tmp.path().join("thesis"), &["--constants", "thesis"]);
+    let k = &thesis["constants"];
+    assert_eq!(k["family"], "thesis");
+    assert!(k.get("s_h").is_none() && k.get("rewards").is_none());
+    let (g, vol) = (0.99f64, 8.0);
+    let psi = 4.0 * (7f64.sqrt() - 2.0) * (7f64.sqrt() / 2.0 - 2.0).exp()
+        / (2.0 * std::f64::consts::PI).sqrt();
+    let c = LQG1D_R * LQG1D_M * LQG1D_M / ((1.0 - g).powi(2) * sigma * sigma)
+        * (vol / ((2.0 * std::f64::consts::PI).sqrt() * sigma) + g / (2.0 * (1.0 - g)));
+    let d = LQG1D_R / (1.0 - g).powi(2) * (psi * vol / (2.0 * sigma) + g / (1.0 - g));
+    assert!((k["c_sigma0"][0].as_f64().expect("c") - c).abs() <= 1e-12 * c);
+    assert!((k["d_sigma0"][0].as_f64().expect("d") - d).abs() <= 1e-12 * d);
+    let config = read(&tmp.path().join("thesis").join("config.toml"));
+    assert!(config.contains("constants = \"thesis\"") && !config.contains("rewards ="));
+}
+
+/// Mountain Car terminates and pays +100 at the goal: its tight constants are two-sided, and
+/// stating its rewards non-positive is refused.
+#[test]
+fn mountain_car_uses_the_two_sided_constants() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("mc");
+    let d = dir.display().to_string();
+    sepg_ok(&[
+        "run",
+        "--env",
+        "mountain-car",
+        "--iterations",
+        "1",
+        "--batch",
+        "12",
+        "--horizon",
+        "30",
+        "--quiet",
+        "--out",
+        &d,
+    ]);
+    let k = json(&dir.join("summary.json"))["constants"].clone();
+    assert_eq!(k["family"], "tight");
+    assert_eq!(k["rewards"], "two-sided");
+    assert_eq!(k["horizon"].as_u64(), Some(30));
+    let r = k["r_max"].as_f64().expect("R");
+    assert!(rel_close(
+        k["d_sigma0"][0].as_f64().expect("d"),
+        2.0 * r * s_h_closed(0.99, 30)
+    ));
+    let bad = tmp.path().join("bad");
+    let b = bad.display().to_string();
+    let line = assert_rejected(
+        &[
+            "run",
+            "--env",
+            "mountain-car",
+            "--rewards",
+            "non-positive",
+            "--out",
+            &b,
+        ],
+        &bad,
+    );
+    assert!(line.contains("rewards"), "{line}");
+}
+
+/// A config.toml written before the `constants` key existed ran with the thesis's constants,
+/// and loads so: a thesis run whose config.toml has lost the key (and whose summary is
+/// missing, as if killed before writing it) is finished with the thesis's constants.
+#[test]
+fn an_old_configuration_without_the_key_loads_as_thesis() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("old");
+    let before = short_lqg1d_run(&dir, &["--constants", "thesis"]);
+    let path = dir.join("config.toml");
+    let old: String = read(&path)
+        .lines()
+        .filter(|l| !l.starts_with("constants =") && !l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(!old.contains("constants"));
+    std::fs::write(&path, old).expect("write");
+    std::fs::remove_file(dir.join("summary.json")).expect("remove");
+    sepg_ok(&["run", "--resume", &dir.display().to_string(), "--quiet"]);
+    let after = json(&dir.join("summary.json"));
+    assert_eq!(after["constants"]["family"], "thesis");
+    assert_eq!(after["constants"], before["constants"]);
+}
+
+#[test]
+fn bad_constants_values_are_one_line_exit_2() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("bad");
+    let o = out.display().to_string();
+    let line = assert_rejected(&["run", "--constants", "foo", "--out", &o], &out);
+    assert!(line.contains("--constants"), "{line}");
+    let line = assert_rejected(
+        &[
+            "run",
+            "--constants",
+            "thesis",
+            "--rewards",
+            "two-sided",
+            "--out",
+            &o,
+        ],
+        &out,
+    );
+    assert!(line.contains("rewards"), "{line}");
 }

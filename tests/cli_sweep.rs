@@ -390,3 +390,53 @@ fn summary_csv_matches_the_runs(sweep: &Path, table: &str) {
         );
     }
 }
+
+/// `sepg sweep --constants` replaces the family of every run, the file's key included; without
+/// it a run takes the file's key, else tight.
+#[test]
+fn the_constants_flag_sets_every_run_of_the_sweep() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let cfg = sweep_file(
+        tmp.path(),
+        r#"
+presets = ["lqg1d"]
+seeds = 1
+sigma0 = [1.0]
+[base]
+iterations = 2
+batch = 12
+[[variant]]
+name = "zv"
+algo = "sepg-zv"
+[[variant]]
+name = "mi-thesis"
+algo = "sepg-mi"
+constants = "thesis"
+"#,
+    );
+    let family = |sweep: &Path, variant: &str| {
+        let run = sweep.join(format!("runs/lqg1d/{variant}/sigma-1.0/seed-0"));
+        json(&run.join("summary.json"))["constants"]["family"]
+            .as_str()
+            .expect("family")
+            .to_owned()
+    };
+    let plain = tmp.path().join("plain");
+    sweep_into(&cfg, &plain, &[], "1");
+    assert_eq!(family(&plain, "zv"), "tight");
+    assert_eq!(family(&plain, "mi-thesis"), "thesis");
+    let thesis = tmp.path().join("thesis");
+    sweep_into(&cfg, &thesis, &["--constants", "thesis"], "1");
+    assert_eq!(family(&thesis, "zv"), "thesis");
+    let tight = tmp.path().join("tight");
+    sweep_into(&cfg, &tight, &["--constants", "tight"], "1");
+    assert_eq!(family(&tight, "mi-thesis"), "tight");
+    let line = assert_usage_error(&sepg(&[
+        "sweep",
+        "--resume",
+        tight.to_str().expect("utf-8"),
+        "--constants",
+        "thesis",
+    ]));
+    assert!(line.contains("--resume"), "{line}");
+}

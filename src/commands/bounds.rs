@@ -6,9 +6,11 @@ use std::collections::BTreeMap;
 use clap::Args;
 use sepg_bounds::constants::{self, TaskConstants};
 use sepg_bounds::outcome::StepOutcome;
+use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
 use sepg_certified::Interval;
 use sepg_certified::{self as certified, Certified, Quadratic};
+use sepg_runs::spec::{ConstantsName, RewardsName};
 use serde::Serialize;
 
 use crate::cli::CliError;
@@ -58,9 +60,19 @@ pub struct BoundsArgs {
     /// Gradient accuracy ε > 0 for the Chebyshev batch sizes.
     #[arg(long, allow_hyphen_values = true)]
     eps: Option<f64>,
-    /// Horizon H ≥ 1 for the Chebyshev batch sizes.
-    #[arg(long)]
-    horizon: Option<u32>,
+    /// Horizon H ≥ 1 (or `inf`): of the tight constants, and of the Chebyshev batch sizes
+    /// (finite there).
+    #[arg(long, value_parser = parse_horizon, allow_hyphen_values = true)]
+    horizon: Option<Horizon>,
+    /// Family of the constants c and d: the thesis's (Theorems 3.14, 4.2, 4.3) or the tight
+    /// constants c = ρRM_φ²S_H/σ², d = 2ρRS_H (docs/THEOREMS.md, "Tight constants"), which
+    /// need --horizon.
+    #[arg(long, value_enum, default_value = "thesis")]
+    constants: ConstantsName,
+    /// Sign of the rewards for the tight constants: two-sided (ρ = 1, always sound) or
+    /// non-positive (every reward in [−R, 0], ρ = 1/2) [default: two-sided].
+    #[arg(long, value_enum)]
+    rewards: Option<RewardsName>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     json: bool,
@@ -69,6 +81,19 @@ pub struct BoundsArgs {
     /// enclosure of their bound (docs/THEOREMS.md, Certified steps).
     #[arg(long)]
     certified: bool,
+}
+
+/// Parses `--horizon`: a positive integer, or `inf` for H = ∞.
+fn parse_horizon(s: &str) -> Result<Horizon, String> {
+    match s.trim() {
+        "inf" | "infinite" => Ok(Horizon::Infinite),
+        t => match t.parse::<u64>() {
+            Ok(h) if h >= 1 => Ok(Horizon::Finite(h)),
+            _ => Err(format!(
+                "the horizon is a positive integer or inf, got {s:?}"
+            )),
+        },
+    }
 }
 
 /// Enclosures and certified steps of `sepg bounds --certified`.
@@ -165,6 +190,15 @@ fn compute_certified(
 /// determine them.
 #[derive(Debug, Default, Serialize)]
 struct BoundsReport {
+    constants: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    horizon: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rewards: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    s_h: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rho: Option<f64>,
     psi: f64,
     c: f64,
     d: f64,
@@ -317,22 +351,77 @@ fn fill_w(
 
 /// The batch sizes of Corollary 3.13, when --delta, --eps and --horizon are all given.
 fn fill_batch(r: &mut BoundsReport, a: &BoundsArgs, k: &TaskConstants) -> Result<(), CliError> {
+    let tight = a.constants == ConstantsName::Tight;
     match (a.delta, a.eps, a.horizon) {
-        (Some(delta), Some(eps), Some(h)) => {
+        (Some(delta), Some(eps), Some(horizon)) => {
+            let h = match horizon {
+                Horizon::Finite(h) => u32::try_from(h).map_err(|_| {
+                    CliError::usage(format!("batch sizes need --horizon at most {}", u32::MAX))
+                })?,
+                Horizon::Infinite => {
+                    return Err(CliError::usage("batch sizes need a finite --horizon"));
+                }
+            };
             r.batch_reinforce =
                 Some(batch_size::reinforce(k, a.sigma, delta, eps, h).map_err(bad)?);
             r.batch_gpomdp = Some(batch_size::gpomdp(k, a.sigma, delta, eps, h).map_err(bad)?);
             Ok(())
         }
         (None, None, None) => Ok(()),
+        (None, None, Some(_)) if tight => Ok(()),
         _ => Err(CliError::usage(
             "batch sizes need all of --delta, --eps and --horizon",
         )),
     }
 }
 
-fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
+/// The task constants of the arguments, with the family of --constants (the tight family
+/// for --horizon and --rewards), and the report's fields naming the family: its name,
+/// horizon, reward sign, S_H and ρ.
+fn task_constants(a: &BoundsArgs) -> Result<(TaskConstants, BoundsReport), CliError> {
     let k = TaskConstants::new(a.gamma, a.r_max, a.m_phi, a.action_volume).map_err(bad)?;
+    match a.constants {
+        ConstantsName::Thesis => {
+            if a.rewards.is_some() {
+                return Err(CliError::usage(
+                    "--rewards applies to --constants tight only",
+                ));
+            }
+            let r = BoundsReport {
+                constants: "thesis",
+                ..BoundsReport::default()
+            };
+            Ok((k, r))
+        }
+        ConstantsName::Tight => {
+            let horizon = a.horizon.ok_or_else(|| {
+                CliError::usage("--constants tight needs --horizon (a positive integer or inf)")
+            })?;
+            let (rewards, name, rho) = match a.rewards.unwrap_or(RewardsName::TwoSided) {
+                RewardsName::TwoSided => (Rewards::TwoSided, "two-sided", 1.0),
+                RewardsName::NonPositive => (Rewards::NonPositive, "non-positive", 0.5),
+            };
+            let k = k
+                .with_family(Family::Tight(Tight::new(horizon, rewards)))
+                .map_err(bad)?;
+            let r = BoundsReport {
+                constants: "tight",
+                horizon: Some(match horizon {
+                    Horizon::Finite(h) => h.to_string(),
+                    Horizon::Infinite => "inf".to_owned(),
+                }),
+                rewards: Some(name),
+                s_h: Some(k.horizon_weight()),
+                rho: Some(rho),
+                ..BoundsReport::default()
+            };
+            Ok((k, r))
+        }
+    }
+}
+
+fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
+    let (k, family) = task_constants(a)?;
     let sigma = a.sigma;
     let (required_v, required_w) = requirements(a)?;
     let c = constants::c(&k, sigma).map_err(bad)?;
@@ -345,7 +434,7 @@ fn compute(a: &BoundsArgs) -> Result<BoundsReport, CliError> {
         beta_star: w_update::beta_star(&k, sigma).map_err(bad)?,
         required_v,
         required_w,
-        ..BoundsReport::default()
+        ..family
     };
     if let Some(m) = dim_v(a)? {
         r.surrogate_coefficient = Some(1.0 / (4.0 * m as f64 * c));
@@ -425,14 +514,33 @@ fn push_optional_rows<'a>(r: &BoundsReport, rows: &mut Vec<(&'a str, String, &'a
 }
 
 fn render_table(r: &BoundsReport) -> String {
-    let mut rows: Vec<(&str, String, &str)> = vec![
+    let tight = r.s_h.is_some();
+    let (c_cite, d_cite) = if tight {
+        ("Thm T: rho R M^2 S_H / sigma^2", "Thm T: 2 rho R S_H")
+    } else {
+        ("Thm 4.2 (Papini et al. Thm 3.14)", "Thm 4.3")
+    };
+    let mut rows: Vec<(&str, String, &str)> = vec![(
+        "constants",
+        r.constants.to_owned(),
+        if tight {
+            "docs/THEOREMS.md, Tight constants"
+        } else {
+            "the thesis's c and d"
+        },
+    )];
+    if let (Some(h), Some(sign), Some(s_h), Some(rho)) = (&r.horizon, r.rewards, r.s_h, r.rho) {
+        rows.extend([
+            ("horizon", h.clone(), "H"),
+            ("rewards", sign.to_owned(), "reward sign"),
+            ("s_h", format!("{s_h:.6e}"), "sum_{t<H} (t+1) gamma^t"),
+            ("rho", format!("{rho}"), "1 two-sided, 1/2 non-positive"),
+        ]);
+    }
+    rows.extend([
         ("psi", format!("{:.10}", r.psi), "Lemma A.1"),
-        (
-            "c",
-            format!("{:.6e}", r.c),
-            "Thm 4.2 (Papini et al. Thm 3.14)",
-        ),
-        ("d", format!("{:.6e}", r.d), "Thm 4.3"),
+        ("c", format!("{:.6e}", r.c), c_cite),
+        ("d", format!("{:.6e}", r.d), d_cite),
         ("dc_dsigma", format!("{:.6e}", r.dc_dsigma), "Appendix B"),
         (
             "alpha_star",
@@ -446,7 +554,7 @@ fn render_table(r: &BoundsReport) -> String {
         ),
         ("required_v", format!("{:.6e}", r.required_v), "(4.13)"),
         ("required_w", format!("{:.6e}", r.required_w), "(4.14)"),
-    ];
+    ]);
     push_optional_rows(r, &mut rows);
     let mut out = String::new();
     for (name, value, cite) in rows {

@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use sepg_runs::spec::ConstantsName;
 use sepg_runs::sweep::{self, Shard, SweepFile, SweepOptions, SweepStats};
 
 use crate::cli::CliError;
@@ -29,6 +30,10 @@ pub struct SweepArgs {
     /// Write into a non-empty folder, replacing a previous sweep's files there.
     #[arg(long)]
     force: bool,
+    /// Family of the constants c and d of every run, replacing the sweep file's `constants`
+    /// keys [default: the file's, else tight].
+    #[arg(long, value_enum)]
+    constants: Option<ConstantsName>,
     /// No progress bar and no summary line.
     #[arg(long)]
     quiet: bool,
@@ -90,7 +95,12 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         observer: &bar,
     };
     let (dir, file, stats) = if let Some(dir) = &args.resume {
-        if args.config.is_some() || args.out.is_some() || args.shard.is_some() || args.force {
+        if args.config.is_some()
+            || args.out.is_some()
+            || args.shard.is_some()
+            || args.force
+            || args.constants.is_some()
+        {
             return Err(CliError::usage(
                 "--resume takes no other options than --quiet and --checkpoint-every",
             ));
@@ -103,7 +113,12 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             .config
             .as_ref()
             .ok_or_else(|| CliError::usage("--config FILE.toml is required"))?;
-        let spec = sweep::read_spec(path)?;
+        let mut spec = sweep::read_spec(path)?;
+        if let Some(c) = args.constants {
+            for run in std::iter::once(&mut spec.base).chain(spec.variant.iter_mut()) {
+                run.constants = Some(c);
+            }
+        }
         let shard = match &args.shard {
             Some(s) if s == "slurm" => sweep::slurm_shard(|k| std::env::var(k).ok())?,
             Some(s) => sweep::parse_shard(s)?,

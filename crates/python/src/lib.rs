@@ -16,6 +16,7 @@ use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use sepg_bounds::constants::TaskConstants;
+use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 
 pub mod bounds;
 pub mod envs;
@@ -79,23 +80,147 @@ pub(crate) fn vector(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
     Ok(values)
 }
 
-/// The task constants of the thesis's bounds: discount γ ∈ [0, 1), reward bound R_max > 0
+/// The family of constants named by `constants` ("thesis" or "tight"), the tight family for
+/// `horizon` (a positive integer, or `inf` as a float or the string "inf") and `rewards`
+/// ("two-sided" or "non-positive").
+fn family(
+    constants: &str,
+    horizon: Option<&Bound<'_, PyAny>>,
+    rewards: Option<&str>,
+) -> PyResult<Family> {
+    match constants {
+        "thesis" => {
+            if horizon.is_some() || rewards.is_some() {
+                return Err(invalid(
+                    "horizon and rewards apply to constants=\"tight\" only",
+                ));
+            }
+            Ok(Family::Thesis)
+        }
+        "tight" => {
+            let h = horizon.ok_or_else(|| {
+                invalid("constants=\"tight\" needs horizon (a positive integer or inf)")
+            })?;
+            let horizon = if let Ok(n) = h.extract::<i64>() {
+                match u64::try_from(n) {
+                    Ok(n) if n >= 1 => Horizon::Finite(n),
+                    _ => return Err(invalid(format!("horizon must be at least 1, got {n}"))),
+                }
+            } else if h.extract::<f64>().is_ok_and(|x| x == f64::INFINITY)
+                || h.extract::<String>().is_ok_and(|s| s == "inf")
+            {
+                Horizon::Infinite
+            } else {
+                return Err(invalid(format!(
+                    "horizon must be a positive integer or inf, got {h}"
+                )));
+            };
+            let rewards = match rewards.unwrap_or("two-sided") {
+                "two-sided" => Rewards::TwoSided,
+                "non-positive" => Rewards::NonPositive,
+                other => {
+                    return Err(invalid(format!(
+                        "rewards = {other:?} must be \"two-sided\" or \"non-positive\""
+                    )));
+                }
+            };
+            Ok(Family::Tight(Tight::new(horizon, rewards)))
+        }
+        other => Err(invalid(format!(
+            "constants = {other:?} must be \"thesis\" or \"tight\""
+        ))),
+    }
+}
+
+/// The task constants of the bounds: discount γ ∈ [0, 1), reward bound R_max > 0
 /// (|r| ≤ R_max), feature bound M_φ > 0 (|φ_i(s)| ≤ M_φ) and action-space volume |A| > 0
-/// (Sec 3.4, Assumptions 4.1–4.2).
+/// (Sec 3.4, Assumptions 4.1–4.2), with the family of the penalty coefficients c and d: the
+/// thesis's (Theorems 3.14, 4.2, 4.3; the default) or the tight constants
+/// c = ρ R M_φ² S_H / σ², d = 2ρ R S_H (docs/THEOREMS.md, "Tight constants"), which need the
+/// horizon H and, to halve them, rewards stated non-positive.
 #[pyclass(frozen, name = "TaskConstants", module = "sepg")]
 #[derive(Debug, Clone, Copy)]
 pub struct PyTaskConstants(pub(crate) TaskConstants);
 
 #[pymethods]
 impl PyTaskConstants {
-    /// Validated constants; raises `InvalidInputError` (a `ValueError`) for γ ∉ [0, 1) or a
-    /// bound that is not finite and positive.
+    /// Validated constants; raises `InvalidInputError` (a `ValueError`) for γ ∉ [0, 1), a
+    /// bound that is not finite and positive, an unknown family or reward sign, or a tight
+    /// family without a horizon of at least 1 step.
     #[new]
-    #[pyo3(signature = (gamma, r_max, m_phi, action_volume))]
-    fn new(gamma: f64, r_max: f64, m_phi: f64, action_volume: f64) -> PyResult<Self> {
+    #[pyo3(signature = (gamma, r_max, m_phi, action_volume, *, constants = "thesis", horizon = None, rewards = None))]
+    fn new(
+        gamma: f64,
+        r_max: f64,
+        m_phi: f64,
+        action_volume: f64,
+        constants: &str,
+        horizon: Option<&Bound<'_, PyAny>>,
+        rewards: Option<&str>,
+    ) -> PyResult<Self> {
+        let family = family(constants, horizon, rewards)?;
         TaskConstants::new(gamma, r_max, m_phi, action_volume)
+            .and_then(|k| k.with_family(family))
             .map(PyTaskConstants)
             .map_err(invalid)
+    }
+
+    /// The same constants with the family `constants` ("thesis" or "tight"; for "tight", the
+    /// `horizon` and the `rewards` sign, "two-sided" unless stated), as the constructor takes
+    /// them.
+    #[pyo3(signature = (constants, *, horizon = None, rewards = None))]
+    fn with_family(
+        &self,
+        constants: &str,
+        horizon: Option<&Bound<'_, PyAny>>,
+        rewards: Option<&str>,
+    ) -> PyResult<Self> {
+        let family = family(constants, horizon, rewards)?;
+        self.0
+            .with_family(family)
+            .map(PyTaskConstants)
+            .map_err(invalid)
+    }
+
+    /// The family of c and d: "thesis" or "tight".
+    #[getter]
+    fn family(&self) -> &'static str {
+        match self.0.family() {
+            Family::Tight(_) => "tight",
+            _ => "thesis",
+        }
+    }
+
+    /// The horizon H of the tight constants as a float (`inf` for H = ∞); `None` for the
+    /// thesis's.
+    #[getter]
+    fn horizon(&self) -> Option<f64> {
+        match self.0.family() {
+            Family::Tight(t) => Some(match t.horizon() {
+                Horizon::Finite(h) => h as f64,
+                Horizon::Infinite => f64::INFINITY,
+            }),
+            _ => None,
+        }
+    }
+
+    /// The reward sign of the tight constants ("two-sided" or "non-positive"); `None` for the
+    /// thesis's.
+    #[getter]
+    fn rewards(&self) -> Option<&'static str> {
+        match self.0.family() {
+            Family::Tight(t) => Some(match t.rewards() {
+                Rewards::TwoSided => "two-sided",
+                Rewards::NonPositive => "non-positive",
+            }),
+            _ => None,
+        }
+    }
+
+    /// S_H = Σ_{t<H} (t + 1) γᵗ of the tight constants; `None` for the thesis's.
+    #[getter]
+    fn horizon_weight(&self) -> Option<f64> {
+        matches!(self.0.family(), Family::Tight(_)).then(|| self.0.horizon_weight())
     }
 
     /// Discount factor γ.
@@ -146,8 +271,15 @@ impl PyTaskConstants {
             .0
             .psi_override()
             .map_or(String::new(), |p| format!(", psi={p:?}"));
+        let family = match (self.horizon(), self.rewards()) {
+            (Some(h), Some(r)) if h.is_finite() => {
+                format!(", constants='tight', horizon={h}, rewards='{r}'")
+            }
+            (Some(_), Some(r)) => format!(", constants='tight', horizon=inf, rewards='{r}'"),
+            _ => String::new(),
+        };
         format!(
-            "TaskConstants(gamma={:?}, r_max={:?}, m_phi={:?}, action_volume={:?}{psi})",
+            "TaskConstants(gamma={:?}, r_max={:?}, m_phi={:?}, action_volume={:?}{family}{psi})",
             self.0.gamma(),
             self.0.r_max(),
             self.0.m_phi(),

@@ -22,7 +22,10 @@ use sepg_algo::core::statement::{SelfCheck, Statement};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::spec::{Resolved, RunSpec, ScoresName, VERSION};
+use crate::spec::{ConstantsName, Resolved, RewardsName, RunSpec, ScoresName, VERSION};
+use sepg_bounds::BoundsError;
+use sepg_bounds::constants::{self, TaskConstants};
+use sepg_bounds::penalties::{Family, Horizon, Rewards};
 
 /// Resolved configuration of a run.
 pub const CONFIG_FILE: &str = "config.toml";
@@ -313,8 +316,9 @@ pub struct Summary {
     pub self_check: Option<SelfCheck>,
 }
 
-/// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+/// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides), their
+/// family, and the penalty coefficients c and d at σ⁰ (docs/THEOREMS.md, "Tight constants").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UsedConstants {
     /// Discount factor γ.
     pub gamma: f64,
@@ -328,6 +332,90 @@ pub struct UsedConstants {
     /// summaries of older versions, which always used that value).
     #[serde(default = "sepg_bounds::constants::psi")]
     pub psi: f64,
+    /// The family of c and d (absent from the summaries of older versions, which used the
+    /// thesis's).
+    #[serde(default = "ConstantsName::legacy")]
+    pub family: ConstantsName,
+    /// The horizon H of the tight constants (the run's horizon); absent for the thesis's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub horizon: Option<u64>,
+    /// The reward sign of the tight constants; absent for the thesis's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rewards: Option<RewardsName>,
+    /// S_H = Σ_{t<H} (t + 1) γᵗ of the tight constants; absent for the thesis's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub s_h: Option<f64>,
+    /// c(σ⁰_j) for each component of σ⁰, `None` where not representable (empty in the
+    /// summaries of older versions).
+    #[serde(default)]
+    pub c_sigma0: Vec<Option<f64>>,
+    /// d(σ⁰_j) for each component of σ⁰, `None` where not representable (empty in the
+    /// summaries of older versions).
+    #[serde(default)]
+    pub d_sigma0: Vec<Option<f64>>,
+}
+
+impl Default for UsedConstants {
+    fn default() -> Self {
+        UsedConstants {
+            gamma: 0.0,
+            r_max: 0.0,
+            m_phi: 0.0,
+            action_volume: 0.0,
+            psi: sepg_bounds::constants::psi(),
+            family: ConstantsName::legacy(),
+            horizon: None,
+            rewards: None,
+            s_h: None,
+            c_sigma0: Vec::new(),
+            d_sigma0: Vec::new(),
+        }
+    }
+}
+
+impl UsedConstants {
+    /// The constants of the resolved run `resolved`, with c and d at its σ⁰ (`None` where
+    /// one is not representable, σ⁰ extremely small).
+    pub fn of(resolved: &Resolved) -> Self {
+        let k = resolved.checked.constants();
+        let at = |f: fn(&TaskConstants, f64) -> std::result::Result<f64, BoundsError>| {
+            resolved
+                .checked
+                .config()
+                .sigma0
+                .iter()
+                .map(|&s| f(k, s).ok())
+                .collect::<Vec<Option<f64>>>()
+        };
+        let (family, horizon, rewards, s_h) = match k.family() {
+            Family::Tight(t) => (
+                ConstantsName::Tight,
+                match t.horizon() {
+                    Horizon::Finite(h) => Some(h),
+                    Horizon::Infinite => None,
+                },
+                Some(match t.rewards() {
+                    Rewards::NonPositive => RewardsName::NonPositive,
+                    Rewards::TwoSided => RewardsName::TwoSided,
+                }),
+                Some(k.horizon_weight()),
+            ),
+            _ => (ConstantsName::Thesis, None, None, None),
+        };
+        UsedConstants {
+            gamma: k.gamma(),
+            r_max: k.r_max(),
+            m_phi: k.m_phi(),
+            action_volume: k.action_volume(),
+            psi: k.psi_used(),
+            family,
+            horizon,
+            rewards,
+            s_h,
+            c_sigma0: at(constants::c),
+            d_sigma0: at(constants::d),
+        }
+    }
 }
 
 /// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.
@@ -374,7 +462,9 @@ pub fn is_complete(dir: &Path) -> bool {
     dir.join(SUMMARY_FILE).is_file()
 }
 
-/// Reads and resolves the configuration of the run folder `dir`.
+/// Reads and resolves the configuration of the run folder `dir`. A `config.toml` without
+/// the `constants` key was written before the family could be chosen and resolves with the
+/// thesis's constants, which it ran with.
 ///
 /// # Errors
 /// [`Error::Invalid`] for a missing or invalid configuration or one written by another sepg version.
@@ -386,7 +476,9 @@ pub fn load_resolved(dir: &Path) -> Result<Resolved> {
             dir.display()
         )));
     }
-    let spec = RunSpec::from_file(&path)?;
+    let mut spec = RunSpec::from_file(&path)?;
+    // A configuration written before the constants could be chosen ran with the thesis's.
+    spec.constants.get_or_insert(ConstantsName::legacy());
     if let Some(v) = &spec.sepg_version
         && v != VERSION
     {

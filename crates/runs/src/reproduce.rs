@@ -13,8 +13,8 @@ use clap::ValueEnum;
 
 use crate::error::{Error, Result};
 use crate::spec::{
-    AccountingName, AlgoName, ConfidenceName, EnvName, FitName, Lb1Name, RunSpec, ScheduleName,
-    ScoresName, WDirectionName, WStepName,
+    AccountingName, AlgoName, ConfidenceName, ConstantsName, EnvName, FitName, Lb1Name, RunSpec,
+    ScheduleName, ScoresName, WDirectionName, WStepName,
 };
 use crate::sweep::{self, Seeds, Shard, SweepFile, SweepOptions, SweepSpec, SweepStats};
 
@@ -128,6 +128,7 @@ impl Setting {
             Setting::ThesisCode => OptionFlags {
                 accounting: Some(AccountingName::Estimated),
                 schedule: Some(ScheduleName::Iteration),
+                constants: Some(ConstantsName::Thesis),
                 confidence: Some(ConfidenceName::None),
                 w_direction: Some(WDirectionName::PlugIn),
                 reference_batch: Some(0),
@@ -138,6 +139,7 @@ impl Setting {
             Setting::PotionLiteral => OptionFlags {
                 accounting: Some(AccountingName::Estimated),
                 schedule: Some(ScheduleName::Iteration),
+                constants: Some(ConstantsName::Thesis),
                 confidence: Some(ConfidenceName::None),
                 w_direction: Some(WDirectionName::Metagradient),
                 lb1_requirement: Some(Lb1Name::Full),
@@ -151,6 +153,7 @@ impl Setting {
             Setting::NoConfidence => OptionFlags {
                 accounting: Some(AccountingName::Estimated),
                 schedule: Some(ScheduleName::Iteration),
+                constants: Some(ConstantsName::Thesis),
                 confidence: Some(ConfidenceName::None),
                 reference_batch: Some(0),
                 ..OptionFlags::default()
@@ -221,6 +224,10 @@ pub struct OptionFlags {
     /// iteration].
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     pub schedule: Option<ScheduleName>,
+    /// Family of the constants c and d of every variant's bounds [default: tight, with each
+    /// preset's reward sign and the run's horizon; the thesis settings: thesis].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    pub constants: Option<ConstantsName>,
 }
 
 impl OptionFlags {
@@ -247,7 +254,8 @@ impl OptionFlags {
             scores,
             certified_steps,
             accounting,
-            schedule
+            schedule,
+            constants
         )
     }
 
@@ -278,6 +286,7 @@ impl OptionFlags {
             certified_steps: self.certified_steps.filter(|_| sepg),
             accounting: self.accounting.filter(|_| sepg),
             schedule: self.schedule.filter(|_| sepg),
+            constants: self.constants,
             ..RunSpec::default()
         }
     }
@@ -562,5 +571,67 @@ mod tests {
             assert_eq!(v.scores, Some(ScoresName::Clipped));
             assert_eq!((v.alternating, v.lb1_requirement), (None, None));
         }
+    }
+
+    /// The thesis's settings keep the thesis's constants for every variant; the default
+    /// setting leaves the key to the runs' default (tight), and `--constants` overrides both.
+    #[test]
+    fn thesis_settings_keep_the_thesis_constants_and_the_default_takes_tight() {
+        let one = crate::sweep::Shard { index: 0, count: 1 };
+        for setting in [
+            Setting::ThesisCode,
+            Setting::PotionLiteral,
+            Setting::NoConfidence,
+        ] {
+            let opts = ReproduceOptions {
+                setting,
+                preset: Some(LqgPreset::Lqg1d),
+                seeds: 1,
+                ..ReproduceOptions::new(Experiment::Table51)
+            };
+            let spec = sweep_spec(&opts).expect("valid");
+            assert!(
+                spec.variant
+                    .iter()
+                    .all(|v| v.constants == Some(ConstantsName::Thesis))
+            );
+            let (_, resolved) = crate::sweep::expand(&spec, one).expect("resolves");
+            assert!(
+                resolved
+                    .iter()
+                    .all(|r| r.checked.constants().family()
+                        == sepg_bounds::penalties::Family::Thesis)
+            );
+        }
+        let default = ReproduceOptions {
+            preset: Some(LqgPreset::Lqg1d),
+            seeds: 1,
+            ..ReproduceOptions::new(Experiment::Table51)
+        };
+        let spec = sweep_spec(&default).expect("valid");
+        assert!(spec.variant.iter().all(|v| v.constants.is_none()));
+        let (_, resolved) = crate::sweep::expand(&spec, one).expect("resolves");
+        let tight = sepg_bounds::penalties::Family::Tight(sepg_bounds::penalties::Tight::new(
+            sepg_bounds::penalties::Horizon::Finite(20),
+            sepg_bounds::penalties::Rewards::NonPositive,
+        ));
+        assert!(
+            resolved
+                .iter()
+                .all(|r| r.checked.constants().family() == tight)
+        );
+        let thesis = ReproduceOptions {
+            flags: OptionFlags {
+                constants: Some(ConstantsName::Thesis),
+                ..OptionFlags::default()
+            },
+            ..default
+        };
+        let spec = sweep_spec(&thesis).expect("valid");
+        assert!(
+            spec.variant
+                .iter()
+                .all(|v| v.constants == Some(ConstantsName::Thesis))
+        );
     }
 }

@@ -301,16 +301,7 @@ fn finish(
         iterations_per_s: rate(s.iteration as f64),
         env_steps_per_s: rate(s.steps as f64),
         options: resolved.checked.config().options,
-        constants: {
-            let k = resolved.checked.constants();
-            UsedConstants {
-                gamma: k.gamma(),
-                r_max: k.r_max(),
-                m_phi: k.m_phi(),
-                action_volume: k.action_volume(),
-                psi: k.psi_used(),
-            }
-        },
+        constants: UsedConstants::of(resolved),
         scores: resolved.spec.scores,
         certified_steps: resolved.spec.certified_steps,
         statement: Some(resolved.checked.statement()),

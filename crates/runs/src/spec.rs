@@ -9,10 +9,11 @@ use std::path::Path;
 
 #[cfg(feature = "clap")]
 use clap::{Args, ValueEnum};
+use sepg_algo::core::config::reward_sign;
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::options::{
-    Accounting, Confidence, ConstantOverrides, Lb1Requirement, Schedule as WidthSchedule,
-    SepgOptions, WDirection, WStep,
+    Accounting, Confidence, ConstantOverrides, ConstantsFamily, Lb1Requirement, RewardSign,
+    Schedule as WidthSchedule, SepgOptions, WDirection, WStep,
 };
 use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
@@ -288,6 +289,62 @@ pub enum ScheduleName {
     Iteration,
 }
 
+/// The family of constants c and d of the bounds, accepted by `--constants`
+/// (docs/THEOREMS.md, "Tight constants").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ConstantsName {
+    /// c of Theorems 3.14 / 4.2 and d of Theorem 4.3 (the thesis).
+    Thesis,
+    /// c = ρ R M_φ² S_H / σ² and d = 2ρ R S_H (Theorem T) for the run's horizon H.
+    Tight,
+}
+
+impl ConstantsName {
+    /// The family's name in configurations and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ConstantsName::Thesis => "thesis",
+            ConstantsName::Tight => "tight",
+        }
+    }
+
+    /// The family of a configuration written before the option existed: the thesis's.
+    pub fn legacy() -> Self {
+        ConstantsName::Thesis
+    }
+}
+
+/// What is known of the sign of the rewards, accepted by `--rewards` (tight constants only).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum RewardsName {
+    /// Rewards of either sign (ρ = 1): always sound.
+    TwoSided,
+    /// Every reward in [−R, 0] (ρ = 1/2): the LQG presets.
+    NonPositive,
+}
+
+impl RewardsName {
+    /// The algorithm's reward sign for this name.
+    pub fn sign(self) -> RewardSign {
+        match self {
+            RewardsName::TwoSided => RewardSign::TwoSided,
+            RewardsName::NonPositive => RewardSign::NonPositive,
+        }
+    }
+
+    /// The name of the algorithm's reward sign.
+    pub fn of(sign: RewardSign) -> Self {
+        match sign {
+            RewardSign::TwoSided => RewardsName::TwoSided,
+            RewardSign::NonPositive => RewardsName::NonPositive,
+        }
+    }
+}
+
 /// LB-I's requirement per half-step, accepted by `--lb1-requirement`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
@@ -543,6 +600,17 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub schedule: Option<ScheduleName>,
+    /// Family of the constants c and d of every bound: the thesis's, or the tight constants
+    /// of Theorem T for the run's horizon [default: tight; a config.toml without the key, written
+    /// before it existed: thesis].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constants: Option<ConstantsName>,
+    /// Sign of the rewards for the tight constants: non-positive halves c and d [default: the
+    /// environment's: non-positive for the LQG presets, two-sided for mountain-car].
+    #[cfg_attr(feature = "clap", arg(long, value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rewards: Option<RewardsName>,
 }
 
 macro_rules! overlay_fields {
@@ -560,7 +628,7 @@ impl RunSpec {
             estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
             metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
             reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps,
-            accounting, schedule)
+            accounting, schedule, constants, rewards)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -597,7 +665,7 @@ impl RunSpec {
         self.reject_inapplicable(algo, gradients)?;
         let method = self.method(algo)?;
         let sampling = self.sampling(gradients);
-        let options = self.options(algo, gradients);
+        let options = self.options(algo, gradients, reward_sign(&env));
         let dim_w = env.action_dim();
         let dim_v = dim_w * env.feature_dim();
         let start = self.start(env_name, dim_v, dim_w)?;
@@ -694,6 +762,11 @@ impl RunSpec {
             !sepg && (self.accounting.is_some() || self.schedule.is_some()),
             "accounting/schedule",
             &for_algo,
+        )?;
+        reject(
+            self.rewards.is_some() && self.constants == Some(ConstantsName::Thesis),
+            "rewards",
+            "to the thesis's constants (only the tight constants use the reward sign)",
         )?;
         reject(
             self.alternating == Some(true) && self.accounting != Some(AccountingName::Estimated),
@@ -798,7 +871,12 @@ impl RunSpec {
 
     /// The SEPG options with their defaults ([`SepgOptions`]); for the comparison algorithms
     /// only the constant overrides (the options were checked to apply).
-    fn options(&self, algo: AlgoName, gradients: GradientsName) -> Option<SepgOptions> {
+    fn options(
+        &self,
+        algo: AlgoName,
+        gradients: GradientsName,
+        env_rewards: RewardSign,
+    ) -> Option<SepgOptions> {
         let overrides = ConstantOverrides {
             gamma: self.gamma,
             r_max: self.r_max,
@@ -806,10 +884,17 @@ impl RunSpec {
             action_volume: self.action_volume,
             psi: self.psi,
         };
+        let constants = match self.constants.unwrap_or(ConstantsName::Tight) {
+            ConstantsName::Thesis => ConstantsFamily::Thesis,
+            ConstantsName::Tight => ConstantsFamily::Tight {
+                rewards: self.rewards.map_or(env_rewards, RewardsName::sign),
+            },
+        };
         let defaults = SepgOptions::default();
         if !algo.is_sepg() {
             return Some(SepgOptions {
                 overrides,
+                constants,
                 ..defaults
             });
         }
@@ -854,6 +939,7 @@ impl RunSpec {
                 Some(ScheduleName::Iteration) => WidthSchedule::Iteration,
                 Some(ScheduleName::Run) | None => defaults.schedule,
             },
+            constants,
         })
     }
 
@@ -968,12 +1054,20 @@ impl RunSpec {
         let Some(o) = options else {
             return RunSpec::default();
         };
+        let (constants, rewards) = match o.constants {
+            ConstantsFamily::Thesis => (ConstantsName::Thesis, None),
+            ConstantsFamily::Tight { rewards } => {
+                (ConstantsName::Tight, Some(RewardsName::of(rewards)))
+            }
+        };
         let overrides = RunSpec {
             gamma: o.overrides.gamma,
             r_max: o.overrides.r_max,
             m_phi: o.overrides.m_phi,
             action_volume: o.overrides.action_volume,
             psi: o.overrides.psi,
+            constants: Some(constants),
+            rewards,
             ..RunSpec::default()
         };
         let (sepg, naive, lb1) = match method.algorithm {
@@ -1160,13 +1254,41 @@ pub struct Resolved {
 }
 
 impl Resolved {
-    /// The resolved configuration as TOML text.
+    /// The resolved configuration as TOML text. The options are followed by comment lines
+    /// that state the constants the bounds use: their family, and for the tight family its
+    /// horizon, reward sign and S_H, then c and d at σ⁰ (comments, so that reading the file
+    /// back sees the options only).
     ///
     /// # Errors
     /// [`Error::Failed`] if serialisation fails.
     pub fn toml(&self) -> Result<String> {
-        toml::to_string(&self.spec)
-            .map_err(|e| Error::failed(format!("cannot serialise the configuration: {e}")))
+        let mut text = toml::to_string(&self.spec)
+            .map_err(|e| Error::failed(format!("cannot serialise the configuration: {e}")))?;
+        let used = crate::folder::UsedConstants::of(self);
+        text.push_str(&format!(
+            "# constants used by the bounds: {}",
+            used.family.name()
+        ));
+        if let (Some(h), Some(r), Some(s_h)) = (used.horizon, used.rewards, used.s_h) {
+            let sign = match r {
+                RewardsName::TwoSided => "two-sided",
+                RewardsName::NonPositive => "non-positive",
+            };
+            text.push_str(&format!(", horizon {h}, rewards {sign}, S_H = {s_h:?}"));
+        }
+        let list = |v: &[Option<f64>]| {
+            let items: Vec<String> = v
+                .iter()
+                .map(|x| x.map_or_else(|| "not representable".to_owned(), |x| format!("{x:?}")))
+                .collect();
+            format!("[{}]", items.join(", "))
+        };
+        text.push_str(&format!(
+            "\n# c(sigma0) = {}\n# d(sigma0) = {}\n",
+            list(&used.c_sigma0),
+            list(&used.d_sigma0)
+        ));
+        Ok(text)
     }
 
     /// v* of the LQG environments (the unclipped infinite-horizon optimum of the closed-form oracle), `None`
@@ -1346,6 +1468,64 @@ mod tests {
         ];
         for spec in bad {
             assert!(spec.resolve().is_err(), "{spec:?}");
+        }
+    }
+
+    /// The constants family: tight by default with the preset's reward sign and the run's
+    /// horizon, the thesis's on request; `rewards` only with the tight family, and
+    /// non-positive refused on Mountain Car; every choice survives config.toml.
+    #[test]
+    fn the_constants_family_resolves_and_round_trips() {
+        use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+        let tight = |h, r| Family::Tight(Tight::new(Horizon::Finite(h), r));
+        let cases = [
+            (RunSpec::default(), tight(20, Rewards::NonPositive)),
+            (
+                RunSpec {
+                    env: Some(EnvName::MountainCar),
+                    horizon: Some(30),
+                    ..RunSpec::default()
+                },
+                tight(30, Rewards::TwoSided),
+            ),
+            (
+                RunSpec {
+                    rewards: Some(RewardsName::TwoSided),
+                    algo: Some(AlgoName::Adastep),
+                    ..RunSpec::default()
+                },
+                tight(20, Rewards::TwoSided),
+            ),
+            (
+                RunSpec {
+                    constants: Some(ConstantsName::Thesis),
+                    r_max: Some(3.0),
+                    ..RunSpec::default()
+                },
+                Family::Thesis,
+            ),
+        ];
+        for (spec, family) in cases {
+            let once = spec.resolve().expect("valid");
+            assert_eq!(once.checked.constants().family(), family, "{spec:?}");
+            let again: RunSpec = toml::from_str(&once.toml().expect("toml")).expect("parse");
+            let twice = again.resolve().expect("valid");
+            assert_eq!(once.spec, twice.spec);
+            assert_eq!(once.checked, twice.checked);
+        }
+        for bad in [
+            RunSpec {
+                constants: Some(ConstantsName::Thesis),
+                rewards: Some(RewardsName::TwoSided),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                env: Some(EnvName::MountainCar),
+                rewards: Some(RewardsName::NonPositive),
+                ..RunSpec::default()
+            },
+        ] {
+            assert!(bad.resolve().is_err(), "{bad:?}");
         }
     }
 

@@ -7,7 +7,7 @@ use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
-use crate::core::options::{SepgOptions, VDirection, WDirection};
+use crate::core::options::{ConstantsFamily, RewardSign, SepgOptions, VDirection, WDirection};
 use crate::core::state::State;
 use crate::core::statement::Statement;
 
@@ -330,6 +330,17 @@ impl SepgConfig {
                 ),
             };
         }
+        if self.options.constants
+            == (ConstantsFamily::Tight {
+                rewards: RewardSign::NonPositive,
+            })
+            && reward_sign(&self.env) != RewardSign::NonPositive
+        {
+            return Err(ConfigError::UnsupportedOption {
+                option: "rewards",
+                reason: "the environment has positive rewards (Mountain Car's goal reward)",
+            });
+        }
         if self.iterations == 0 {
             return Err(ConfigError::ZeroIterations);
         }
@@ -393,12 +404,34 @@ impl SepgConfig {
             Some(psi) => c.with_psi(psi),
             None => Ok(c),
         })
+        .and_then(|c| c.with_family(self.options.constants.family(self.horizon)))
         .map_err(|e| ConfigError::Environment(e.to_string()))?;
+        check_v_direction(&self.options, &constants)?;
         Ok(CheckedConfig {
             inner: self,
             constants,
             certified: true,
         })
+    }
+}
+
+/// What is known of the sign of the rewards of `env`, for the tight constants
+/// (docs/THEOREMS.md, "Tight constants"): the LQG environments' reward −(sᵀQs + aᵀRa), with Q
+/// and R positive semi-definite (checked when the model is built), is never positive; Mountain
+/// Car pays +100 at the goal, so its rewards have both signs.
+///
+/// # Examples
+/// ```
+/// use sepg_algo::core::config::reward_sign;
+/// use sepg_algo::core::options::RewardSign;
+/// use sepg_mdp::env::Preset;
+/// assert_eq!(reward_sign(&Preset::Lqg1d.build()), RewardSign::NonPositive);
+/// assert_eq!(reward_sign(&Preset::MountainCar.build()), RewardSign::TwoSided);
+/// ```
+pub fn reward_sign(env: &AnyEnv) -> RewardSign {
+    match env {
+        AnyEnv::Lqg(_) => RewardSign::NonPositive,
+        AnyEnv::MountainCar(_) => RewardSign::TwoSided,
     }
 }
 
@@ -416,7 +449,9 @@ impl CheckedConfig {
         &self.inner
     }
 
-    /// The validated task constants R, M_φ, |A|, γ of the environment (docs/CONVENTIONS.md §1).
+    /// The validated task constants R, M_φ, |A|, γ of the environment (docs/CONVENTIONS.md §1),
+    /// after the overrides, with the family of [`SepgOptions::constants`] (the tight family for
+    /// the run's horizon H).
     pub fn constants(&self) -> &TaskConstants {
         &self.constants
     }
@@ -457,11 +492,12 @@ impl CheckedConfig {
     /// # Examples
     /// ```
     /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
-    /// use sepg_algo::core::options::{SepgOptions, VDirection};
+    /// use sepg_algo::core::options::{ConstantsFamily, RewardSign, VDirection};
     /// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
     /// use sepg_mdp::env::Preset;
     /// let mut cfg = SepgConfig::new(Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Mi));
     /// cfg.options.v_direction = VDirection::adam(1e-2);
+    /// cfg.options.constants = ConstantsFamily::Tight { rewards: RewardSign::NonPositive };
     /// let checked = cfg.check()?;
     /// let tight = Family::Tight(Tight::new(Horizon::Finite(20), Rewards::NonPositive));
     /// assert!(checked.clone().with_family(tight).is_ok());

@@ -14,6 +14,8 @@
 //! | [`SepgOptions::accounting`] | [`Accounting::Certified`] | [`Accounting::Estimated`] |
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 //! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
+//! | [`SepgOptions::constants`] | [`ConstantsFamily::Thesis`] (`sepg run`: tight) | [`ConstantsFamily::Thesis`] |
+use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use serde::{Deserialize, Serialize};
 
 use crate::core::error::ConfigError;
@@ -189,6 +191,69 @@ impl Schedule {
     }
 }
 
+/// What is known of the sign of every reward r_t of a task (|r_t| ≤ R always).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RewardSign {
+    /// Rewards of either sign: the two-sided tight constants (ρ = 1). Always sound.
+    TwoSided,
+    /// −R ≤ r_t ≤ 0 for every t (the LQG presets, whose reward −(sᵀQs + aᵀRa) has Q and R
+    /// positive semi-definite): the tight constants halve (ρ = 1/2).
+    NonPositive,
+}
+
+impl RewardSign {
+    /// The reward sign of `sepg-bounds`' tight family.
+    pub fn rewards(self) -> Rewards {
+        match self {
+            RewardSign::TwoSided => Rewards::TwoSided,
+            RewardSign::NonPositive => Rewards::NonPositive,
+        }
+    }
+}
+
+/// The family of constants that gives the penalty coefficients c(σ) and d(σ) of every bound
+/// of a run (docs/THEOREMS.md, "Tight constants").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ConstantsFamily {
+    /// c of Theorems 3.14 / 4.2 and d of Theorem 4.3 (the thesis).
+    #[default]
+    Thesis,
+    /// The tight constants c = ρ R M_φ² S_H / σ² and d = 2ρ R S_H of Theorem T, with S_H for
+    /// the run's horizon H ([`crate::core::config::SepgConfig::horizon`]).
+    Tight {
+        /// What is known of the rewards' sign (ρ = 1 two-sided, 1/2 non-positive).
+        rewards: RewardSign,
+    },
+}
+
+impl ConstantsFamily {
+    /// The family of summaries written before the option existed: the thesis's.
+    fn legacy() -> Self {
+        ConstantsFamily::Thesis
+    }
+
+    /// The family of `sepg-bounds` for a run of `horizon` steps.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::{ConstantsFamily, RewardSign};
+    /// use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
+    /// let f = ConstantsFamily::Tight { rewards: RewardSign::NonPositive };
+    /// let expected = Family::Tight(Tight::new(Horizon::Finite(20), Rewards::NonPositive));
+    /// assert_eq!(f.family(20), expected);
+    /// assert_eq!(ConstantsFamily::Thesis.family(20), Family::Thesis);
+    /// ```
+    pub fn family(self, horizon: usize) -> Family {
+        match self {
+            ConstantsFamily::Thesis => Family::Thesis,
+            ConstantsFamily::Tight { rewards } => Family::Tight(Tight::new(
+                Horizon::Finite(horizon as u64),
+                rewards.rewards(),
+            )),
+        }
+    }
+}
+
 /// Overrides of the task constants R, M_φ, |A|, γ and ψ that the bounds use.
 ///
 /// `gamma` also changes the environment's discount, so J itself changes; the others only
@@ -248,6 +313,12 @@ pub struct SepgOptions {
     /// The direction of the v-update.
     #[serde(default, skip_serializing_if = "VDirection::is_greedy")]
     pub v_direction: VDirection,
+    /// The family of the penalty coefficients c and d, applied by
+    /// [`crate::core::config::SepgConfig::check`] (a solver built from a collector takes the
+    /// family of the task constants it is given). Absent from summaries written before the
+    /// option existed, which used the thesis's.
+    #[serde(default = "ConstantsFamily::legacy")]
+    pub constants: ConstantsFamily,
 }
 
 impl Default for SepgOptions {
@@ -263,6 +334,7 @@ impl Default for SepgOptions {
             accounting: Accounting::Certified,
             schedule: Schedule::Run,
             v_direction: VDirection::Greedy,
+            constants: ConstantsFamily::Thesis,
         }
     }
 }

@@ -5,7 +5,7 @@
 //! exceeds 1e-12·max(1, |J|), the tolerance of `sepg audit`.
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::error::ConfigError;
-use sepg_algo::core::options::{Confidence, SepgOptions, VDirection};
+use sepg_algo::core::options::{Confidence, ConstantsFamily, RewardSign, SepgOptions, VDirection};
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::PolicySolver;
@@ -82,6 +82,9 @@ fn safe_adam(lr: f64, sigma0: f64, gradient: GradientMode, seed: u64) -> Checked
         options: SepgOptions {
             v_direction: VDirection::adam(lr),
             confidence: Confidence::StudentT { factor: 1.0 },
+            constants: ConstantsFamily::Tight {
+                rewards: RewardSign::NonPositive,
+            },
             ..SepgOptions::default()
         },
         ..SepgConfig::new(lqg1d(true), Algorithm::Sepg(Requirement::Mi))
@@ -148,14 +151,20 @@ fn safe_adam_is_refused_where_it_is_not_proven() {
         },
         ..SepgConfig::new(lqg1d(true), Algorithm::Sepg(Requirement::Mi))
     };
-    let checked = cfg.clone().check().expect("valid options");
+    // the library's default family is the thesis's: refused when the configuration is checked
     assert!(matches!(
-        PolicySolver::new(&checked),
+        cfg.clone().check(),
         Err(ConfigError::UnsupportedOption {
             option: "v_direction",
             ..
         })
     ));
+    let mut tight_cfg = cfg.clone();
+    tight_cfg.options.constants = ConstantsFamily::Tight {
+        rewards: RewardSign::NonPositive,
+    };
+    let checked = tight_cfg.check().expect("valid options");
+    assert!(PolicySolver::new(&checked).is_ok());
     assert!(matches!(
         checked.with_family(Family::Thesis),
         Err(ConfigError::UnsupportedOption {

@@ -10,9 +10,35 @@ ArrayLike = Union[npt.ArrayLike, Sequence[float]]
 Adaptive = Tuple[Optional[float], Optional[float], str]
 
 class TaskConstants:
-    """gamma in [0, 1), R_max > 0, M_phi > 0, |A| > 0 (Sec 3.4, Assumptions 4.1-4.2)."""
+    """gamma in [0, 1), R_max > 0, M_phi > 0, |A| > 0 (Sec 3.4, Assumptions 4.1-4.2), and the
+    family of c and d: "thesis" (default) or "tight" (docs/THEOREMS.md, "Tight constants")."""
 
-    def __init__(self, gamma: float, r_max: float, m_phi: float, action_volume: float) -> None: ...
+    def __init__(
+        self,
+        gamma: float,
+        r_max: float,
+        m_phi: float,
+        action_volume: float,
+        *,
+        constants: str = "thesis",
+        horizon: Optional[Union[int, float, str]] = None,
+        rewards: Optional[str] = None,
+    ) -> None: ...
+    def with_family(
+        self,
+        constants: str,
+        *,
+        horizon: Optional[Union[int, float, str]] = None,
+        rewards: Optional[str] = None,
+    ) -> TaskConstants: ...
+    @property
+    def family(self) -> str: ...
+    @property
+    def horizon(self) -> Optional[float]: ...
+    @property
+    def rewards(self) -> Optional[str]: ...
+    @property
+    def horizon_weight(self) -> Optional[float]: ...
     @property
     def gamma(self) -> float: ...
     @property

@@ -248,7 +248,12 @@ class GymRun:
     bookkeeping) and ``reference_batch``, the N0 trajectories that estimate J(theta^0) before
     SEPG's first iteration under the estimated bookkeeping (default 1000; 0 takes it from the
     first v-block, as the thesis's pseudocode). ``horizon`` defaults to the environment's
-    ``max_episode_steps``.
+    ``max_episode_steps``. ``constants`` is the family of the penalty coefficients c and d of
+    every bound: ``"tight"`` (the default, as for ``sepg run``: c = rho R M_phi^2 S_H / sigma^2
+    and d = 2 rho R S_H for the run's horizon, docs/THEOREMS.md "Tight constants") or
+    ``"thesis"`` (Theorems 3.14, 4.2 and 4.3). A gymnasium environment states nothing about
+    the sign of its rewards, so the tight constants are two-sided (rho = 1) unless
+    ``rewards="non-positive"`` says that every reward lies in [-R_max, 0] (rho = 1/2).
     """
 
     def __init__(
@@ -269,6 +274,8 @@ class GymRun:
         sigma0: Optional[Sequence[float]] = None,
         initial_budget: float = 0.0,
         show_derivation: bool = True,
+        constants: str = "tight",
+        rewards: Optional[str] = None,
         **options: Any,
     ) -> None:
         gymnasium = _gymnasium()
@@ -298,6 +305,11 @@ class GymRun:
                 )
         if not isinstance(horizon, int) or horizon < 1:
             raise InvalidInputError(f"horizon must be a positive integer, got {horizon!r}")
+        self.constants = self.constants.with_family(
+            constants,
+            horizon=horizon if constants == "tight" else None,
+            rewards=rewards,
+        )
         if not isinstance(action_space, gymnasium.spaces.Box) or len(action_space.shape) != 1:
             raise InvalidInputError(
                 f"the action space must be a one-dimensional Box, got {action_space}"
