@@ -85,7 +85,8 @@ pub enum LqgPreset {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
 pub enum Setting {
-    /// sepg's defaults: the exploring w-update, Student-t widths at δ, the reference batch of
+    /// sepg's defaults: the tight constants, the certified accounting, proven (sub-Gaussian)
+    /// widths with δ spread over the run, the exploring w-update, the reference batch of
     /// J(θ⁰), cross-fitted ∇̂_w L, ν-split LB-I, leave-one-out baselines.
     #[default]
     Default,
