@@ -875,3 +875,43 @@ fn bad_constants_values_are_one_line_exit_2() {
     );
     assert!(line.contains("rewards"), "{line}");
 }
+
+/// Issue figure: exact-gradient SEPG-MI on `lqg1d` from σ⁰ = 1 with the default (tight)
+/// constants reaches |v − v*| ≤ 0.0075 in 10,000 iterations (the best unsafe constant step
+/// of Table 5.1 at σ⁰ = 1), with no exact violation. The run's σ stays at 1, so its limit is
+/// the optimum of the clipped H = 20 model at σ = 1, v = −0.6088961175847956 (where the DP's
+/// ∂J/∂v vanishes), 0.0064 from the unclipped v* of the closed form. With the thesis's
+/// constants the same run ends at 0.505 (steps 5,700 times smaller).
+#[test]
+fn exact_mi_with_the_tight_constants_reaches_the_clipped_optimum_without_a_violation() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("mi");
+    let d = dir.to_str().expect("utf-8");
+    sepg_ok(&[
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-mi",
+        "--gradients",
+        "exact",
+        "--sigma0",
+        "1",
+        "--iterations",
+        "10000",
+        "--out",
+        d,
+    ]);
+    let summary = json(&dir.join("summary.json"));
+    assert_eq!(summary["constants"]["family"], "tight");
+    assert_eq!(summary["statement"]["kind"], "proven");
+    let v = summary["final"]["v"][0].as_f64().expect("v");
+    assert!((v - -0.608_896_117_584_795_6).abs() < 1e-6, "v = {v}");
+    let u = (v - v_star()).abs();
+    assert!(u <= 0.0075, "|v − v*| = {u}");
+    // against exact J, every half-step: the audit holds (exit 0, no failed check)
+    let out = sepg(&["audit", d, "--json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(report["verdict"], "holds", "{report}");
+}
