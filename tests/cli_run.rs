@@ -915,3 +915,168 @@ fn exact_mi_with_the_tight_constants_reaches_the_clipped_optimum_without_a_viola
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(report["verdict"], "holds", "{report}");
 }
+
+/// The arguments of a safe-Adam run: exact-gradient SEPG-MI on `lqg1d` from σ⁰ = 1, Adam's
+/// learning rate 0.1, into `dir`.
+fn safe_adam_args(dir: &Path, iterations: &str) -> Vec<String> {
+    [
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-mi",
+        "--v-direction",
+        "adam",
+        "--adam-lr",
+        "0.1",
+        "--gradients",
+        "exact",
+        "--iterations",
+        iterations,
+        "--quiet",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([dir.display().to_string()])
+    .collect()
+}
+
+/// Safe Adam on the command line: the run records its v-direction with Adam's usual betas in
+/// config.toml and summary.json, promises a proven statement (exact gradients, tight
+/// constants, certified accounting), and `sepg audit` finds that every half-step kept J from
+/// decreasing against the exact J of the dynamic programme. v moves toward v* and J rises.
+#[test]
+fn a_safe_adam_run_records_its_direction_and_its_proven_statement_holds() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("adam");
+    sepg_ok(&safe_adam_args(&dir, "200"));
+    let config = read(&dir.join("config.toml"));
+    for line in [
+        "v-direction = \"adam\"",
+        "adam-lr = 0.1",
+        "adam-beta1 = 0.9",
+        "adam-beta2 = 0.999",
+    ] {
+        assert!(config.lines().any(|l| l == line), "{line} in {config}");
+    }
+    let summary = json(&dir.join("summary.json"));
+    let adam = &summary["options"]["v_direction"]["Adam"];
+    assert_eq!(adam["lr"], 0.1);
+    assert_eq!(adam["beta1"], 0.9);
+    assert_eq!(adam["beta2"], 0.999);
+    assert_eq!(adam["eps"], 1e-8);
+    assert_eq!(summary["statement"]["kind"], "proven");
+    assert_eq!(summary["constants"]["family"], "tight");
+    let v = summary["final"]["v"][0].as_f64().expect("v");
+    assert!((v - v_star()).abs() < (-0.1 - v_star()).abs(), "v = {v}");
+    let audit = sepg(&["audit", "--json", &dir.display().to_string()]);
+    let report: serde_json::Value = serde_json::from_slice(&audit.stdout).expect("json");
+    assert_eq!(audit.status.code(), Some(0), "{report}");
+    assert_eq!(report["verdict"], "holds", "{report}");
+    assert_eq!(report["rows"], 200);
+}
+
+/// A safe-Adam run stopped by SIGINT at a checkpoint resumes from its config.toml (and Adam's
+/// moments in the checkpoint) to the uninterrupted run, bit for bit.
+#[test]
+fn a_safe_adam_run_resumes_bit_identically() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let reference = tmp.path().join("reference");
+    sepg_ok(&safe_adam_args(&reference, "3000"));
+    let dir = tmp.path().join("interrupted");
+    let args = [
+        safe_adam_args(&dir, "3000"),
+        vec!["--checkpoint-every".into(), "100".into()],
+    ]
+    .concat();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // About 1 ms of CPU time per exact iteration: 2,900 iterations are left after the
+    // checkpoint of iteration 100, far more than sending the signal takes.
+    wait_for_checkpoint(&mut child, &dir, 100);
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!dir.join("summary.json").exists());
+    resume(&dir);
+    assert_same_run(&reference, &dir);
+    assert_eq!(
+        json(&dir.join("summary.json"))["options"],
+        json(&reference.join("summary.json"))["options"]
+    );
+}
+
+/// Safe Adam is refused with one line and exit status 2 where it is not proven (the thesis's
+/// constants, the estimated accounting), without its learning rate, and its parameters are
+/// refused without `--v-direction adam`; no run folder is written.
+#[test]
+fn safe_adam_where_unproven_is_one_line_exit_2() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("bad");
+    let o = out.display().to_string();
+    let base = ["run", "--env", "lqg1d", "--algo", "sepg-mi", "--out", &o];
+    let adam = ["--v-direction", "adam", "--adam-lr", "0.1"];
+    for (extra, needles) in [
+        (
+            [&adam[..], &["--constants", "thesis"]].concat(),
+            ["v-direction", "thesis"],
+        ),
+        (
+            [&adam[..], &["--accounting", "estimated"]].concat(),
+            ["v-direction", "estimated"],
+        ),
+        (
+            vec!["--adam-lr", "0.1"],
+            ["adam-lr", "without v-direction adam"],
+        ),
+        (
+            vec!["--v-direction", "greedy", "--adam-eps", "1e-6"],
+            ["adam-eps", "without v-direction adam"],
+        ),
+        (
+            vec!["--v-direction", "adam"],
+            ["v-direction adam", "--adam-lr"],
+        ),
+        (
+            [&adam[..], &["--adam-beta1", "1"]].concat(),
+            ["beta1", "[0, 1)"],
+        ),
+    ] {
+        let args = [&base[..], &extra[..]].concat();
+        let line = assert_rejected(&args, &out);
+        for needle in needles {
+            assert!(line.contains(needle), "{needle} in {line} for {args:?}");
+        }
+    }
+    let line = assert_rejected(
+        &[
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "adastep",
+            "--v-direction",
+            "adam",
+            "--adam-lr",
+            "0.1",
+            "--out",
+            &o,
+        ],
+        &out,
+    );
+    assert!(line.contains("v-direction"), "{line}");
+}

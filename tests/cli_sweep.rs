@@ -440,3 +440,46 @@ constants = "thesis"
     ]));
     assert!(line.contains("--resume"), "{line}");
 }
+
+/// Safe Adam in a sweep file: the variant's keys reach its run (recorded in summary.json), and
+/// `sepg sweep --constants thesis` over it is refused with one line and exit status 2.
+#[test]
+fn a_sweep_variant_takes_the_adam_v_direction() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let cfg = sweep_file(
+        tmp.path(),
+        r#"
+presets = ["lqg1d"]
+seeds = 1
+sigma0 = [1.0]
+[base]
+iterations = 3
+batch = 12
+[[variant]]
+name = "mi-adam"
+algo = "sepg-mi"
+v-direction = "adam"
+adam-lr = 0.05
+adam-beta1 = 0.5
+"#,
+    );
+    let out = tmp.path().join("sweep");
+    sweep_into(&cfg, &out, &[], "1");
+    let run = out.join("runs/lqg1d/mi-adam/sigma-1.0/seed-0");
+    let adam = &json(&run.join("summary.json"))["options"]["v_direction"]["Adam"];
+    assert_eq!(adam["lr"], 0.05);
+    assert_eq!(adam["beta1"], 0.5);
+    assert_eq!(adam["beta2"], 0.999);
+    let thesis = tmp.path().join("thesis");
+    let line = assert_usage_error(&sepg(&[
+        "sweep",
+        "--quiet",
+        "--config",
+        cfg.to_str().expect("utf-8"),
+        "--out",
+        thesis.to_str().expect("utf-8"),
+        "--constants",
+        "thesis",
+    ]));
+    assert!(line.contains("v-direction"), "{line}");
+}

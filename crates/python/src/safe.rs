@@ -10,6 +10,7 @@ use sepg_algo::core::options::WStep;
 use sepg_algo::solver::sampled::BlockEstimator;
 use sepg_algo::solver::source::{Grad, Need};
 use sepg_algo::solver::steps::{self, Plan};
+use sepg_bounds::direction::{Direction, FeatureNorm};
 use sepg_estimators::{GradientSpec, Width, width};
 use sepg_mdp::Batch;
 
@@ -412,12 +413,70 @@ fn estimate_block<'py>(
     Ok(out)
 }
 
+/// The largest certified step t ∈ [0, `max_step`] along a proposed change `direction` = u of
+/// the mean parameters (Adam's, a natural gradient's, a user optimiser's), for the required
+/// improvement `required` = C, against the estimate `grad` = ĝ of ∇_vJ with half-widths `eps`
+/// (a scalar or one per component; 0 for an exact gradient) (docs/THEOREMS.md, "A step along
+/// any direction"):
+///
+/// B(t) = t·(u·ĝ) − t·Σ|u_i|ε_i − c(σ)·κ_φ·t²·‖u‖₂² ≥ C,
+///
+/// with κ_φ = 1 for a coordinate direction, else p = `features` (the features of one action;
+/// default the length of u, which bounds it) or (M₂/M_φ)² for a stated bound `feature_norm`
+/// = M₂ ≥ ‖φ(s)‖₂. The step is certified in outward-rounded interval arithmetic
+/// (`sepg_certified::direction_safe_step` over `sepg_bounds::direction::DirectionBound`).
+/// `sigma` is the smallest standard deviation of the policy. Returns `(t, guaranteed,
+/// certified)`: `guaranteed` is the lower end of the enclosure of B(t) (performance units);
+/// when `certified` is false no step meets C, and t is the step of largest guarantee within
+/// the cap (its guarantee below C). The thesis's constants are proven for coordinate
+/// directions only: another direction raises `InvalidInputError`.
+#[pyfunction]
+#[pyo3(signature = (constants, sigma, direction, grad, eps, required, max_step = 1.0, features = None, feature_norm = None))]
+#[allow(clippy::too_many_arguments)]
+fn direction_safe_step(
+    constants: PyRef<'_, PyTaskConstants>,
+    sigma: f64,
+    direction: &Bound<'_, PyAny>,
+    grad: &Bound<'_, PyAny>,
+    eps: &Bound<'_, PyAny>,
+    required: f64,
+    max_step: f64,
+    features: Option<usize>,
+    feature_norm: Option<f64>,
+) -> PyResult<(f64, f64, bool)> {
+    let u = vector(direction, "direction")?;
+    let g = self::grad(grad, Some(eps), "grad")?;
+    let features = match (features, feature_norm) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "give at most one of features (p) and feature_norm (M2)",
+            ));
+        }
+        (_, Some(m2)) => FeatureNorm::Stated(m2),
+        (Some(p), None) => FeatureNorm::FromMax { features: p },
+        (None, None) => FeatureNorm::FromMax { features: u.len() },
+    };
+    let d = Direction {
+        direction: &u,
+        grad_hat: &g.value,
+        eps: &g.eps,
+        features,
+    };
+    let outcome = sepg_certified::direction_safe_step(&constants.0, sigma, &d, required, max_step)
+        .map_err(invalid)?;
+    match (outcome.chosen_step(), outcome.bound()) {
+        (Some(t), Some(b)) => Ok((t, b.lo(), outcome.is_certified())),
+        _ => Err(invalid("no step along the direction")),
+    }
+}
+
 /// Adds the functions and classes of this module to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySafeStep>()?;
     m.add_function(wrap_pyfunction!(v_step, m)?)?;
     m.add_function(wrap_pyfunction!(w_step, m)?)?;
     m.add_function(wrap_pyfunction!(ada_step, m)?)?;
+    m.add_function(wrap_pyfunction!(direction_safe_step, m)?)?;
     m.add_function(wrap_pyfunction!(confidence_widths, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_block, m)?)?;
     Ok(())

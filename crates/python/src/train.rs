@@ -10,7 +10,7 @@ use pyo3::types::PyModule;
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
-use sepg_algo::core::options::{Accounting, Confidence, Schedule, SepgOptions};
+use sepg_algo::core::options::{Accounting, Confidence, Schedule, SepgOptions, VDirection};
 use sepg_algo::core::seed::Block;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::sampled::{BatchCollector, BatchRequest};
@@ -79,6 +79,40 @@ pub(crate) fn algorithm(
             }
         },
     })
+}
+
+/// SEPG's v-direction named `name` ("greedy" or "adam") with Adam's parameters, which are
+/// refused without "adam"; "adam" needs `lr`, and its betas and ε default to 0.9, 0.999 and
+/// 1e-8 (their domains are checked with the configuration).
+fn v_direction(
+    name: &str,
+    lr: Option<f64>,
+    beta1: Option<f64>,
+    beta2: Option<f64>,
+    eps: Option<f64>,
+) -> PyResult<VDirection> {
+    match name {
+        "greedy" => {
+            if lr.is_some() || beta1.is_some() || beta2.is_some() || eps.is_some() {
+                return Err(invalid(
+                    "adam_lr, adam_beta1, adam_beta2 and adam_eps apply only with v_direction=\"adam\"",
+                ));
+            }
+            Ok(VDirection::Greedy)
+        }
+        "adam" => {
+            let lr = lr.ok_or_else(|| invalid("v_direction=\"adam\" needs adam_lr"))?;
+            Ok(VDirection::Adam {
+                lr,
+                beta1: beta1.unwrap_or(0.9),
+                beta2: beta2.unwrap_or(0.999),
+                eps: eps.unwrap_or(1e-8),
+            })
+        }
+        other => Err(invalid(format!(
+            "v_direction = {other:?} must be \"greedy\" or \"adam\""
+        ))),
+    }
 }
 
 /// What the collector is asked for: `n` trajectories of the policy
@@ -251,8 +285,14 @@ impl Trainer {
     /// with estimated J), and N₀, the trajectories of the reference batch that estimates
     /// J(θ⁰) before the first iteration of SEPG under the estimated bookkeeping (default 1000;
     /// 0 takes J(θ⁰) from the first v-block as the thesis's pseudocode does; 1 is an error).
+    /// `v_direction` is SEPG's v-update: "greedy" (the default, Theorem 4.2's coordinate) or
+    /// "adam" ("safe Adam": Adam with learning rate `adam_lr` > 0 in units of v, β₁ =
+    /// `adam_beta1` (0.9), β₂ = `adam_beta2` (0.999), ε = `adam_eps` (1e-8) proposes the
+    /// change, and the largest certified step along it at most 1 is taken; docs/THEOREMS.md,
+    /// "A step along any direction"), which needs the tight constants and the certified
+    /// accounting.
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified"))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -274,6 +314,11 @@ impl Trainer {
         lr_w: Option<f64>,
         reference_batch: Option<usize>,
         accounting: &str,
+        v_direction: &str,
+        adam_lr: Option<f64>,
+        adam_beta1: Option<f64>,
+        adam_beta2: Option<f64>,
+        adam_eps: Option<f64>,
     ) -> PyResult<Self> {
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
@@ -340,6 +385,8 @@ impl Trainer {
                 )));
             }
         };
+        options.v_direction =
+            self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
         let solver = PolicySolver::with_collector(&config, Box::new(collector))
             .and_then(|s| s.with_options(options))
             .map_err(invalid)?;

@@ -16,11 +16,12 @@ def blocks(name):
 EXAMPLES = blocks("README.md") + blocks("docs/PYTHON.md")
 
 
-def test_the_readme_has_its_two_examples():
+def test_the_readme_has_its_three_examples():
     readme = [code for name, _, code in EXAMPLES if name == "README.md"]
-    assert len(readme) == 2
+    assert len(readme) == 3
     assert len(readme[0].strip().splitlines()) <= 12
     assert len(readme[1].strip().splitlines()) <= 22
+    assert len(readme[2].strip().splitlines()) <= 12
 
 
 @pytest.mark.parametrize("name,index,code", EXAMPLES, ids=[f"{n}-{i}" for n, i, _ in EXAMPLES])

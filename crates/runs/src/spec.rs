@@ -13,7 +13,7 @@ use sepg_algo::core::config::reward_sign;
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::options::{
     Accounting, Confidence, ConstantOverrides, ConstantsFamily, Lb1Requirement, RewardSign,
-    Schedule as WidthSchedule, SepgOptions, WDirection, WStep,
+    Schedule as WidthSchedule, SepgOptions, VDirection, WDirection, WStep,
 };
 use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
@@ -227,6 +227,19 @@ pub enum WDirectionName {
     PlugIn,
     /// The thesis-era code's w-derivative of J + α‖∇_v J‖² (scalar actions).
     Metagradient,
+}
+
+/// The v-direction accepted by `--v-direction`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum VDirectionName {
+    /// The greedy coordinate of Theorem 4.2 / eq. (4.11) with its largest safe step.
+    Greedy,
+    /// "Safe Adam": Adam proposes the change u, the applied change is t·u with t ≤ 1 the
+    /// largest certified step along u (docs/THEOREMS.md, "A step along any direction"); tight
+    /// constants and certified accounting only.
+    Adam,
 }
 
 /// The confidence widths accepted by `--confidence`.
@@ -516,6 +529,28 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(skip))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sepg_version: Option<String>,
+    /// Direction of the SEPG v-update: the greedy coordinate, or safe Adam (tight constants
+    /// and certified accounting only) [default: greedy].
+    #[cfg_attr(feature = "clap", arg(long = "v-direction", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub v_direction: Option<VDirectionName>,
+    /// Learning rate of safe Adam's proposed change, in units of v per step (> 0; needed by
+    /// v-direction adam).
+    #[cfg_attr(feature = "clap", arg(long = "adam-lr", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adam_lr: Option<f64>,
+    /// First-moment decay β₁ ∈ [0, 1) of safe Adam [default: 0.9].
+    #[cfg_attr(feature = "clap", arg(long = "adam-beta1", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adam_beta1: Option<f64>,
+    /// Second-moment decay β₂ ∈ [0, 1) of safe Adam [default: 0.999].
+    #[cfg_attr(feature = "clap", arg(long = "adam-beta2", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adam_beta2: Option<f64>,
+    /// Denominator offset ε > 0 of safe Adam, in units of ∇_v J [default: 1e-8].
+    #[cfg_attr(feature = "clap", arg(long = "adam-eps", allow_hyphen_values = true))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adam_eps: Option<f64>,
     /// Form of the SEPG w-update [default: exploring].
     #[cfg_attr(feature = "clap", arg(long = "w-step", value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -625,8 +660,8 @@ impl RunSpec {
         let base = self;
         overlay_fields!(base, top; name, env, features, algo, requirement, gradients, delta, nu,
             v0, sigma0, budget0, alpha, beta, lr, lr_w, batch, horizon, iterations, seed,
-            estimator, baseline, baseline_fit, log_every, sepg_version, w_step, w_direction,
-            metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
+            estimator, baseline, baseline_fit, log_every, sepg_version, v_direction, adam_lr,
+            adam_beta1, adam_beta2, adam_eps, w_step, w_direction, metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
             reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps,
             accounting, schedule, constants, rewards)
     }
@@ -754,6 +789,17 @@ impl RunSpec {
             &for_algo,
         )?;
         reject(
+            !sepg
+                && (self.v_direction.is_some()
+                    || self.adam_lr.is_some()
+                    || self.adam_beta1.is_some()
+                    || self.adam_beta2.is_some()
+                    || self.adam_eps.is_some()),
+            "v-direction/adam-lr/adam-beta1/adam-beta2/adam-eps",
+            &for_algo,
+        )?;
+        self.reject_v_direction()?;
+        reject(
             !sepg && self.certified_steps.is_some(),
             "certified-steps",
             &for_algo,
@@ -819,6 +865,40 @@ impl RunSpec {
                     || self.baseline_fit.is_some()),
             "estimator/baseline/baseline-fit",
             "to exact gradients",
+        )
+    }
+
+    /// Refuses safe Adam's parameters without `v-direction adam`, and safe Adam without its
+    /// learning rate, with the thesis's constants (proven for the greedy coordinate only) or
+    /// with the estimated accounting (docs/THEOREMS.md, "A step along any direction").
+    fn reject_v_direction(&self) -> Result<()> {
+        let adam = self.v_direction == Some(VDirectionName::Adam);
+        reject(
+            !adam
+                && (self.adam_lr.is_some()
+                    || self.adam_beta1.is_some()
+                    || self.adam_beta2.is_some()
+                    || self.adam_eps.is_some()),
+            "adam-lr/adam-beta1/adam-beta2/adam-eps",
+            "without v-direction adam",
+        )?;
+        if !adam {
+            return Ok(());
+        }
+        if self.adam_lr.is_none() {
+            return Err(Error::invalid("v-direction adam needs --adam-lr"));
+        }
+        reject(
+            self.constants == Some(ConstantsName::Thesis),
+            "v-direction adam",
+            "with the thesis's constants (their c is proven for the greedy coordinate only; \
+             use constants tight)",
+        )?;
+        reject(
+            self.accounting == Some(AccountingName::Estimated),
+            "v-direction adam",
+            "with accounting estimated (safe Adam is certified at its realised change; use \
+             accounting certified)",
         )
     }
 
@@ -900,7 +980,15 @@ impl RunSpec {
         }
         let sampled = gradients == GradientsName::Sampled;
         Some(SepgOptions {
-            v_direction: defaults.v_direction,
+            v_direction: match (self.v_direction, self.adam_lr) {
+                (Some(VDirectionName::Adam), Some(lr)) => VDirection::Adam {
+                    lr,
+                    beta1: self.adam_beta1.unwrap_or(0.9),
+                    beta2: self.adam_beta2.unwrap_or(0.999),
+                    eps: self.adam_eps.unwrap_or(1e-8),
+                },
+                _ => defaults.v_direction,
+            },
             w_step: match self.w_step {
                 Some(WStepName::Theorem49) => WStep::Theorem49,
                 Some(WStepName::Exploring) => WStep::Exploring,
@@ -1089,7 +1177,21 @@ impl RunSpec {
             WDirection::PlugIn => (WDirectionName::PlugIn, None),
             WDirection::Metagradient { clip } => (WDirectionName::Metagradient, Some(clip)),
         };
+        let (v_direction, adam) = match o.v_direction {
+            VDirection::Greedy => (VDirectionName::Greedy, None),
+            VDirection::Adam {
+                lr,
+                beta1,
+                beta2,
+                eps,
+            } => (VDirectionName::Adam, Some((lr, beta1, beta2, eps))),
+        };
         RunSpec {
+            v_direction: Some(v_direction),
+            adam_lr: adam.map(|a| a.0),
+            adam_beta1: adam.map(|a| a.1),
+            adam_beta2: adam.map(|a| a.2),
+            adam_eps: adam.map(|a| a.3),
             w_step: (!naive).then_some(match o.w_step {
                 WStep::Exploring => WStepName::Exploring,
                 WStep::Theorem49 => WStepName::Theorem49,
@@ -1524,6 +1626,76 @@ mod tests {
                 rewards: Some(RewardsName::NonPositive),
                 ..RunSpec::default()
             },
+        ] {
+            assert!(bad.resolve().is_err(), "{bad:?}");
+        }
+    }
+
+    /// Safe Adam: the TOML keys build the algorithm's `VDirection::Adam` with the usual betas
+    /// by default, survive config.toml, and are refused without `v_direction = "adam"`, without
+    /// a learning rate, with the thesis's constants, with the estimated accounting and for the
+    /// comparison algorithms.
+    #[test]
+    fn the_adam_v_direction_resolves_round_trips_and_is_refused_where_unproven() {
+        let spec: RunSpec = toml::from_str(
+            "algo = \"sepg-mi\"\nv-direction = \"adam\"\nadam-lr = 0.1\nadam-beta2 = 0.99\n",
+        )
+        .expect("parse");
+        let once = spec.resolve().expect("valid");
+        assert_eq!(
+            once.checked.config().options.v_direction,
+            VDirection::Adam {
+                lr: 0.1,
+                beta1: 0.9,
+                beta2: 0.99,
+                eps: 1e-8
+            }
+        );
+        let again: RunSpec = toml::from_str(&once.toml().expect("toml")).expect("parse");
+        let twice = again.resolve().expect("valid");
+        assert_eq!(once.spec, twice.spec);
+        assert_eq!(once.checked, twice.checked);
+        let greedy = RunSpec::default().resolve().expect("valid");
+        assert_eq!(greedy.spec.v_direction, Some(VDirectionName::Greedy));
+        assert_eq!(
+            greedy.checked.config().options.v_direction,
+            VDirection::Greedy
+        );
+        let adam = |more: RunSpec| RunSpec {
+            v_direction: Some(VDirectionName::Adam),
+            adam_lr: Some(0.1),
+            ..more
+        };
+        for bad in [
+            RunSpec {
+                adam_lr: Some(0.1),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                v_direction: Some(VDirectionName::Greedy),
+                adam_eps: Some(1e-6),
+                ..RunSpec::default()
+            },
+            RunSpec {
+                v_direction: Some(VDirectionName::Adam),
+                ..RunSpec::default()
+            },
+            adam(RunSpec {
+                constants: Some(ConstantsName::Thesis),
+                ..RunSpec::default()
+            }),
+            adam(RunSpec {
+                accounting: Some(AccountingName::Estimated),
+                ..RunSpec::default()
+            }),
+            adam(RunSpec {
+                algo: Some(AlgoName::Adastep),
+                ..RunSpec::default()
+            }),
+            adam(RunSpec {
+                adam_beta1: Some(1.0),
+                ..RunSpec::default()
+            }),
         ] {
             assert!(bad.resolve().is_err(), "{bad:?}");
         }

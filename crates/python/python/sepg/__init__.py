@@ -2,7 +2,7 @@
 
 - :mod:`sepg.bounds`: every closed-form safety quantity of the thesis (Chapters 3 and 4).
 - The safe-step API (:func:`v_step`, :func:`w_step`, :func:`ada_step`,
-  :func:`confidence_widths`, :func:`estimate_block`, :func:`required_improvement`): a training
+  :func:`direction_safe_step`, :func:`confidence_widths`, :func:`estimate_block`, :func:`required_improvement`): a training
   loop written with any framework passes its own gradient estimates, per-trajectory samples
   or widths and gets SEPG's safe step sizes, the improvement they guarantee and their flags.
 - :mod:`sepg.gym`: SEPG and the comparison algorithms on any gymnasium environment with a
@@ -35,6 +35,7 @@ from sepg._native import (
     Trainer,
     ada_step,
     confidence_widths,
+    direction_safe_step,
     estimate_block,
     v_step,
     w_step,
@@ -153,6 +154,7 @@ __all__ = [
     "ada_step",
     "bounds",
     "confidence_widths",
+    "direction_safe_step",
     "errors",
     "estimate_block",
     "mountain_car_trajectory",

@@ -320,6 +320,12 @@ class Trainer:
         lr: Optional[float] = None,
         lr_w: Optional[float] = None,
         reference_batch: Optional[int] = None,
+        accounting: str = "certified",
+        v_direction: str = "greedy",
+        adam_lr: Optional[float] = None,
+        adam_beta1: Optional[float] = None,
+        adam_beta2: Optional[float] = None,
+        adam_eps: Optional[float] = None,
     ) -> None: ...
     def run(self, iterations: int) -> str: ...
     def state(self) -> str: ...
@@ -346,6 +352,17 @@ def w_step(
 def ada_step(
     constants: TaskConstants, sigma: float, grad: ArrayLike, eps: Optional[ArrayLike] = None
 ) -> Optional[Tuple[float, float]]: ...
+def direction_safe_step(
+    constants: TaskConstants,
+    sigma: float,
+    direction: ArrayLike,
+    grad: ArrayLike,
+    eps: ArrayLike,
+    required: float,
+    max_step: float = 1.0,
+    features: Optional[int] = None,
+    feature_norm: Optional[float] = None,
+) -> Tuple[float, float, bool]: ...
 def confidence_widths(
     samples: ArrayLike, delta: float = 0.2
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...

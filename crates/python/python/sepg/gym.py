@@ -247,7 +247,9 @@ class GymRun:
     built on the certified guarantees of the applied steps; ``"estimated"``: the thesis's
     bookkeeping) and ``reference_batch``, the N0 trajectories that estimate J(theta^0) before
     SEPG's first iteration under the estimated bookkeeping (default 1000; 0 takes it from the
-    first v-block, as the thesis's pseudocode). ``horizon`` defaults to the environment's
+    first v-block, as the thesis's pseudocode), and ``v_direction`` (``"greedy"``, the default, or
+    ``"adam"`` with ``adam_lr`` and optionally ``adam_beta1``, ``adam_beta2``, ``adam_eps``: safe
+    Adam, as :class:`sepg.Trainer`). ``horizon`` defaults to the environment's
     ``max_episode_steps``. ``constants`` is the family of the penalty coefficients c and d of
     every bound: ``"tight"`` (the default, as for ``sepg run``: c = rho R M_phi^2 S_H / sigma^2
     and d = 2 rho R S_H for the run's horizon, docs/THEOREMS.md "Tight constants") or
