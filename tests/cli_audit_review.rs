@@ -35,33 +35,40 @@ const TOLERANCE: f64 = 1e-12;
 const ORACLE_MARGIN: f64 = 1e-11;
 
 /// The start at the exact v-optimum of each preset (where `sepg exact --clipped` gives
-/// ∂J/∂v = 0 at H = 20), as `sepg run` options.
-const LQG_OPTIMUM: [&str; 6] = [
+/// ∂J/∂v = 0 at H = 20), as `sepg run` options, with the thesis's constants the review ran
+/// (the tight constants of Theorem T came later and are the default now).
+const LQG_OPTIMUM: [&str; 8] = [
     "--env",
     "lqg",
     "--v0",
     "-1.1221115976564946",
     "--sigma0",
     "2",
+    "--constants",
+    "thesis",
 ];
-const LQG1D_OPTIMUM: [&str; 6] = [
+const LQG1D_OPTIMUM: [&str; 8] = [
     "--env",
     "lqg1d",
     "--v0",
     "-0.6088961175847956",
     "--sigma0",
     "1",
+    "--constants",
+    "thesis",
 ];
 
 /// The v-optimum of `lqg1d` at σ = 2 (H = 20): Newton's iteration on `sepg exact --clipped`
 /// from −0.6089 ends where ∂J/∂v = 2e-14.
-const LQG1D_OPTIMUM_SIGMA_2: [&str; 6] = [
+const LQG1D_OPTIMUM_SIGMA_2: [&str; 8] = [
     "--env",
     "lqg1d",
     "--v0",
     "-0.6800643640104588",
     "--sigma0",
     "2",
+    "--constants",
+    "thesis",
 ];
 
 /// The thesis's bookkeeping: requirements on estimated J, widths at δ each, Student-t.
