@@ -48,14 +48,7 @@ impl TaskConstants {
         m_phi: f64,
         action_volume: f64,
     ) -> Result<Self, BoundsError> {
-        finite("gamma", gamma)?;
-        if !(0.0..1.0).contains(&gamma) {
-            return Err(BoundsError::OutOfDomain {
-                name: "gamma",
-                value: gamma,
-                domain: "[0, 1)",
-            });
-        }
+        discount(gamma)?;
         let (r_max, m_phi, action_volume) = (
             positive("r_max", r_max)?,
             positive("m_phi", m_phi)?,
@@ -381,14 +374,7 @@ pub(crate) fn d_parts(k: &TaskConstants, sigma: f64) -> Result<(f64, f64), Bound
 /// # Ok::<(), sepg_bounds::BoundsError>(())
 /// ```
 pub fn s_h(gamma: f64, horizon: Horizon) -> Result<f64, BoundsError> {
-    finite("gamma", gamma)?;
-    if !(0.0..1.0).contains(&gamma) {
-        return Err(BoundsError::OutOfDomain {
-            name: "gamma",
-            value: gamma,
-            domain: "[0, 1)",
-        });
-    }
+    discount(gamma)?;
     let one_minus = 1.0 - gamma;
     let infinite = 1.0 / (one_minus * one_minus);
     let h = match horizon {
@@ -415,6 +401,19 @@ pub fn s_h(gamma: f64, horizon: Horizon) -> Result<f64, BoundsError> {
     let exponent = hf * gamma.ln() + (hf * one_minus).ln_1p();
     let value = -exponent.exp_m1() / (one_minus * one_minus);
     Ok(value.clamp(1.0, infinite))
+}
+
+/// Validates a discount factor: finite and in [0, 1).
+fn discount(gamma: f64) -> Result<f64, BoundsError> {
+    finite("gamma", gamma)?;
+    if !(0.0..1.0).contains(&gamma) {
+        return Err(BoundsError::OutOfDomain {
+            name: "gamma",
+            value: gamma,
+            domain: "[0, 1)",
+        });
+    }
+    Ok(gamma)
 }
 
 /// The largest horizon [`s_h`] sums term by term.
