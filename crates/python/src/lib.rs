@@ -7,6 +7,8 @@
 //! - [`safe`]: the framework-agnostic safe-step API: gradient estimates, per-trajectory
 //!   samples or confidence widths in, SEPG's safe steps, guarantees and flags out
 //!   (Theorems 4.2–4.9).
+//! - [`record`]: the per-iteration records with the columns of `log.csv`, and that file's
+//!   rows written by the CLI's writer.
 //! - [`train`]: SEPG and the comparison algorithms driven by trajectory batches collected in
 //!   Python (any gymnasium environment), through `sepg_algo`'s collector API.
 //!
@@ -21,6 +23,7 @@ use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 pub mod bounds;
 pub mod envs;
 pub mod pyjson;
+pub mod record;
 pub mod runs;
 pub mod safe;
 pub mod train;
@@ -47,8 +50,21 @@ pub(crate) fn floats(
 ) -> PyResult<(Vec<f64>, Vec<usize>)> {
     let py = obj.py();
     let np = py.import("numpy")?;
+    // numpy converts complex numbers (dropping the imaginary part with a warning), strings
+    // and booleans to float64 without an error: only real numbers are taken.
+    let raw = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| invalid(format!("{name} must be an array of real numbers ({e})")))?;
+    let dtype = raw.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(invalid(format!(
+            "{name} must be an array of real numbers, got {} values",
+            dtype.str()?
+        )));
+    }
     let arr = np
-        .call_method1("ascontiguousarray", (obj, "float64"))
+        .call_method1("ascontiguousarray", (raw, "float64"))
         .map_err(|e| invalid(format!("{name} must be an array of real numbers ({e})")))?;
     let arr = arr
         .cast::<PyArrayDyn<f64>>()
@@ -295,9 +311,11 @@ impl PyTaskConstants {
 /// The extension module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyTaskConstants>()?;
     bounds::register(m)?;
     envs::register(m)?;
+    record::register(m)?;
     runs::register(m)?;
     safe::register(m)?;
     train::register(m)?;

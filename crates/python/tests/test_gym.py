@@ -71,7 +71,7 @@ def test_every_algorithm_runs_on_pendulum(algorithm, options):
     )
     arrays = run.run(2)
     assert arrays["iteration"].tolist() == [0, 1]
-    assert np.all(np.isfinite(arrays["j_exploratory"]))
+    assert np.all(np.isfinite(arrays["j_explore"]))
     assert np.all(np.isfinite(run.mean)) and np.all(run.sigma > 0)
 
 
