@@ -22,7 +22,7 @@ use sepg_mdp::{Batch, GaussianPolicy};
 
 use crate::record;
 use crate::safe::lengths_of;
-use crate::{PyTaskConstants, failed, floats, invalid};
+use crate::{PyTaskConstants, failed, floats, invalid, natural, real};
 
 /// The algorithm named as on the command line: `sepg-mi`, `sepg-lb1`, `sepg-lb2`, `sepg-lv`,
 /// `sepg-zv`, `sepg-sim`, `sepg-naive-w` (with `requirement`), `gpomdp-const` (with `alpha`,
@@ -304,7 +304,7 @@ impl Trainer {
     /// "A step along any direction"), which needs the tight constants and the certified
     /// accounting.
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, **unknown))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, **unknown))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -312,13 +312,13 @@ impl Trainer {
         actions: usize,
         features: usize,
         collector: Py<PyAny>,
-        n_trajectories: usize,
-        seed: u64,
-        delta: f64,
+        n_trajectories: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        delta: Option<&Bound<'_, PyAny>>,
         v0: Option<&Bound<'_, PyAny>>,
         sigma0: Option<&Bound<'_, PyAny>>,
-        initial_budget: f64,
-        nu: f64,
+        initial_budget: Option<&Bound<'_, PyAny>>,
+        nu: Option<&Bound<'_, PyAny>>,
         requirement: &str,
         alpha: Option<f64>,
         beta: Option<f64>,
@@ -338,6 +338,13 @@ impl Trainer {
                 "Trainer() got an unexpected keyword argument {key}; its keyword arguments are {TRAINER_KEYWORDS}"
             )));
         }
+        // numbers are read here rather than by pyo3, so that a wrong type names the argument
+        let n_trajectories: usize =
+            n_trajectories.map_or(Ok(100), |n| natural(n, "n_trajectories"))?;
+        let seed: u64 = seed.map_or(Ok(0), |s| natural(s, "seed"))?;
+        let delta = delta.map_or(Ok(0.2), |d| real(d, "delta"))?;
+        let nu = nu.map_or(Ok(0.5), |x| real(x, "nu"))?;
+        let initial_budget = initial_budget.map_or(Ok(0.0), |b| real(b, "initial_budget"))?;
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
             .checked_mul(features)

@@ -74,6 +74,9 @@ def required_improvement(
         )
     import math
 
+    for name, value in (("budget", budget), ("nu", nu), ("j_initial", j_initial), ("j_current", j_current)):
+        if value is not None and (isinstance(value, (bool, str, complex)) or not hasattr(value, "__float__")):
+            raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
     if not math.isfinite(budget) or budget < 0.0:
         raise InvalidInputError(f"budget = {budget} must be finite and non-negative")
     if requirement == "mi":

@@ -249,8 +249,8 @@ class GymRun:
     observation to the feature vector phi(s) (default: the observation itself). ``algorithm``
     is named as on the command line (``sepg-zv``, ``sepg-lv``, ``sepg-mi``, ``sepg-lb1``,
     ``sepg-lb2``, ``sepg-sim``, ``sepg-naive-w``, ``gpomdp-const``, ``gpomdp-adam``,
-    ``adastep``); ``options`` are its hyper-parameters (``nu``, ``requirement``, ``alpha``,
-    ``beta``, ``lr``, ``lr_w``), ``accounting`` (``"certified"``, the default: requirements
+    ``adastep``); its hyper-parameters are ``nu``, ``requirement``, ``alpha``, ``beta``,
+    ``lr`` and ``lr_w`` (as :class:`sepg.Trainer`'s); ``accounting`` (``"certified"``, the default: requirements
     built on the certified guarantees of the applied steps; ``"estimated"``: the thesis's
     bookkeeping) and ``reference_batch``, the N0 trajectories that estimate J(theta^0) before
     SEPG's first iteration under the estimated bookkeeping (default 1000; 0 takes it from the
@@ -263,6 +263,10 @@ class GymRun:
     ``"thesis"`` (Theorems 3.14, 4.2 and 4.3). A gymnasium environment states nothing about
     the sign of its rewards, so the tight constants are two-sided (rho = 1) unless
     ``rewards="non-positive"`` says that every reward lies in [-R_max, 0] (rho = 1/2).
+
+    :meth:`run` runs iterations with optional callbacks (:mod:`sepg.callbacks`), a progress
+    bar and a logger (:class:`sepg.logger.Logger`); ``records`` holds one dict per iteration
+    with the columns of ``log.csv``.
     """
 
     def __init__(
@@ -324,8 +328,9 @@ class GymRun:
                 raise InvalidInputError(
                     f"{_name(env)} has no max_episode_steps: pass horizon"
                 )
-        if not isinstance(horizon, int) or horizon < 1:
+        if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise InvalidInputError(f"horizon must be a positive integer, got {horizon!r}")
+        horizon = int(horizon)
         self.constants = self.constants.with_family(
             constants,
             horizon=horizon if constants == "tight" else None,
@@ -358,8 +363,8 @@ class GymRun:
             n_trajectories=n_trajectories,
             seed=seed,
             delta=delta,
-            v0=None if v0 is None else np.asarray(v0, dtype=float),
-            sigma0=None if sigma0 is None else np.asarray(sigma0, dtype=float),
+            v0=v0,
+            sigma0=sigma0,
             initial_budget=initial_budget,
             nu=nu,
             requirement=requirement,
