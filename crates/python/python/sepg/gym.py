@@ -393,7 +393,10 @@ class GymRun:
     ) -> Dict[str, np.ndarray]:
         """Runs ``iterations`` more iterations, or (``total_timesteps``) iterations until
         this call has used at least that many more environment steps (as stable-baselines3's
-        ``learn``; the ``steps`` column counts the run's steps in all); returns every record so far as arrays (:func:`sepg.records_to_arrays`).
+        ``learn``; the ``steps`` column counts the run's steps in all); returns every record
+        so far as arrays (:func:`sepg.records_to_arrays`). An exception (of the environment,
+        the features or a callback, or Ctrl-C) leaves the run after its last complete
+        iteration, whose record is kept.
 
         ``callback`` is called once per iteration with the iteration's record (see
         :mod:`sepg.callbacks`); when it returns ``False`` the run stops after that
@@ -414,7 +417,7 @@ class GymRun:
             progress_bar,
             total=goal,
             unit="step" if by_steps else "it",
-            desc=self.trainer_label,
+            desc=f"{self.algorithm} on {_name(self.env)}",
         )
         if hooks is not None:
             hooks.on_training_start(self)
@@ -441,11 +444,6 @@ class GymRun:
     def _steps(self) -> int:
         """Environment steps the run has used so far."""
         return int(self.state["steps"])
-
-    @property
-    def trainer_label(self) -> str:
-        """The algorithm and the environment, as the progress bar shows them."""
-        return f"{self.algorithm} on {_name(self.env)}"
 
     @property
     def state(self) -> Dict[str, Any]:
