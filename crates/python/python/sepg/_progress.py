@@ -32,4 +32,4 @@ def progress_bar(enabled: Optional[bool], *, total: int, unit: str, desc: str) -
                 stacklevel=3,
             )
         return None
-    return tqdm(total=total, unit=unit, desc=desc, file=sys.stderr, dynamic_ncols=True)
+    return tqdm(total=total, unit=unit, desc=desc, file=sys.stderr)
