@@ -376,6 +376,8 @@ def test_learn_total_timesteps_and_load_errors(tmp_path):
     with pytest.raises(sepg.InvalidInputError, match="pass features="):
         sepg.SEPG.load(tmp_path / "c.json")
     assert sepg.SEPG.load(tmp_path / "c.json", features=lambda s: s[:2]).run.n_features == 2
+    with pytest.raises(sepg.InvalidInputError, match="unknown requirement 'naive-w'"):
+        model(requirement="naive-w")
     (tmp_path / "x.json").write_text('{"format": "other"}')
     with pytest.raises(sepg.InvalidInputError, match="not a saved sepg model"):
         sepg.SEPG.load(tmp_path / "x.json")

@@ -28,6 +28,8 @@ FORMAT = "sepg-model"
 #: The version of the saved-model format this code writes and reads.
 FORMAT_VERSION = 1
 
+_REQUIREMENTS = ("mi", "lb1", "lb2", "lv", "zv", "sim")
+
 
 class SEPG:
     """Safely-Exploring Policy Gradient (Algorithm 4.3) on a gymnasium environment, as a
@@ -69,8 +71,10 @@ class SEPG:
         adam_eps: Optional[float] = None,
         show_derivation: bool = True,
     ) -> None:
-        if not isinstance(requirement, str):
-            raise InvalidInputError(f"requirement must be a string, got {requirement!r}")
+        if requirement not in _REQUIREMENTS:
+            raise InvalidInputError(
+                f"unknown requirement {requirement!r}: expected one of {', '.join(_REQUIREMENTS)}"
+            )
         self.requirement = requirement
         self.run = GymRun(
             env,
