@@ -543,18 +543,14 @@ mod tests {
                 expected
             );
         }
-        for (text, expected) in [("\"Thesis\"", ConstantsFamily::Thesis)] {
-            assert_eq!(
-                serde_json::from_str::<ConstantsFamily>(text).expect("old"),
-                expected
-            );
-        }
-        for (text, expected) in [("\"TwoSided\"", RewardSign::TwoSided)] {
-            assert_eq!(
-                serde_json::from_str::<RewardSign>(text).expect("old"),
-                expected
-            );
-        }
+        assert_eq!(
+            serde_json::from_str::<ConstantsFamily>("\"Thesis\"").expect("old"),
+            ConstantsFamily::Thesis
+        );
+        assert_eq!(
+            serde_json::from_str::<RewardSign>("\"TwoSided\"").expect("old"),
+            RewardSign::TwoSided
+        );
         assert_eq!(
             serde_json::from_str::<Accounting>("\"Estimated\"").expect("old"),
             Accounting::Estimated
