@@ -448,3 +448,13 @@ def test_gym_arguments_are_not_converted_silently():
     with pytest.raises(sepg.InvalidInputError, match="horizon must be a positive integer"):
         pendulum_run(horizon=True)
     assert pendulum_run(horizon=np.int64(7)).collector.horizon == 7
+
+
+def test_a_model_logs_to_its_logger(tmp_path):
+    m = model()
+    with Logger(tmp_path / "log") as logger:
+        m.set_logger(logger)
+        m.learn(2)
+    lines = (tmp_path / "log" / "log.csv").read_text().splitlines()
+    assert len(lines) == 3 and lines[0].startswith("iteration,v_0,v_1,v_2,w,sigma,j_explore,")
+    assert [int(line.split(",")[0]) for line in lines[1:]] == [r["iteration"] for r in m.records]
