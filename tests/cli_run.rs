@@ -740,8 +740,8 @@ fn a_default_run_records_the_tight_constants_it_used() {
         LQG1D_R * s_h
     ));
     assert_eq!(
-        default["options"]["constants"]["Tight"]["rewards"],
-        "NonPositive"
+        default["options"]["constants"]["tight"]["rewards"],
+        "non-positive"
     );
     let config = read(&tmp.path().join("default").join("config.toml"));
     assert!(config.contains("constants = \"tight\""), "{config}");
@@ -961,7 +961,7 @@ fn a_safe_adam_run_records_its_direction_and_its_proven_statement_holds() {
         assert!(config.lines().any(|l| l == line), "{line} in {config}");
     }
     let summary = json(&dir.join("summary.json"));
-    let adam = &summary["options"]["v_direction"]["Adam"];
+    let adam = &summary["options"]["v_direction"]["adam"];
     assert_eq!(adam["lr"], 0.1);
     assert_eq!(adam["beta1"], 0.9);
     assert_eq!(adam["beta2"], 0.999);

@@ -466,7 +466,7 @@ adam-beta1 = 0.5
     let out = tmp.path().join("sweep");
     sweep_into(&cfg, &out, &[], "1");
     let run = out.join("runs/lqg1d/mi-adam/sigma-1.0/seed-0");
-    let adam = &json(&run.join("summary.json"))["options"]["v_direction"]["Adam"];
+    let adam = &json(&run.join("summary.json"))["options"]["v_direction"]["adam"];
     assert_eq!(adam["lr"], 0.05);
     assert_eq!(adam["beta1"], 0.5);
     assert_eq!(adam["beta2"], 0.999);

@@ -7,20 +7,24 @@
 //! - [`safe`]: the framework-agnostic safe-step API: gradient estimates, per-trajectory
 //!   samples or confidence widths in, SEPG's safe steps, guarantees and flags out
 //!   (Theorems 4.2–4.9).
+//! - [`record`]: the per-iteration records with the columns of `log.csv`, and that file's
+//!   rows written by the CLI's writer.
 //! - [`train`]: SEPG and the comparison algorithms driven by trajectory batches collected in
 //!   Python (any gymnasium environment), through `sepg_algo`'s collector API.
 //!
 //! Bad input never panics and never returns NaN: every error is raised as one of the
 //! exception classes of `sepg.errors`, whose input errors are also `ValueError`s.
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyModule;
+use pyo3::types::{PyComplex, PyFloat, PyModule, PyString};
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 
 pub mod bounds;
 pub mod envs;
 pub mod pyjson;
+pub mod record;
 pub mod runs;
 pub mod safe;
 pub mod train;
@@ -47,8 +51,21 @@ pub(crate) fn floats(
 ) -> PyResult<(Vec<f64>, Vec<usize>)> {
     let py = obj.py();
     let np = py.import("numpy")?;
+    // numpy converts complex numbers (dropping the imaginary part with a warning), strings
+    // and booleans to float64 without an error: only real numbers are taken.
+    let raw = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| invalid(format!("{name} must be an array of real numbers ({e})")))?;
+    let dtype = raw.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(invalid(format!(
+            "{name} must be an array of real numbers, got {} values",
+            dtype.str()?
+        )));
+    }
     let arr = np
-        .call_method1("ascontiguousarray", (obj, "float64"))
+        .call_method1("ascontiguousarray", (raw, "float64"))
         .map_err(|e| invalid(format!("{name} must be an array of real numbers ({e})")))?;
     let arr = arr
         .cast::<PyArrayDyn<f64>>()
@@ -69,6 +86,48 @@ pub(crate) fn floats(
         )));
     }
     Ok((values, shape))
+}
+
+/// The real number passed as the argument `name`: a Python `int` or `float` or anything with
+/// `__float__` (numpy scalars). Anything else (a string, a complex number, `None`) raises a
+/// `TypeError` naming the argument; the domain is checked by the caller.
+pub(crate) fn real(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<f64> {
+    if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyComplex>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must be a real number, got {} {obj}",
+            obj.get_type().name()?
+        )));
+    }
+    obj.extract::<f64>().map_err(|_| {
+        let kind = obj
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_owned(), |n| n.to_string());
+        PyTypeError::new_err(format!("{name} must be a real number, got {kind} {obj}"))
+    })
+}
+
+/// The non-negative integer passed as the argument `name` (a Python `int` or numpy integer,
+/// not a float): a `TypeError` for another type and an `InvalidInputError` for a negative or
+/// too large value, both naming the argument.
+pub(crate) fn natural<T: TryFrom<u64>>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<T> {
+    if obj.is_instance_of::<PyFloat>() || obj.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must be an integer, got {} {obj}",
+            obj.get_type().name()?
+        )));
+    }
+    let n: i128 = obj
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("{name} must be an integer, got {obj}")))?;
+    u64::try_from(n)
+        .ok()
+        .and_then(|n| T::try_from(n).ok())
+        .ok_or_else(|| {
+            invalid(format!(
+                "{name} = {n} must be a non-negative integer in range"
+            ))
+        })
 }
 
 /// A one-dimensional, non-empty, finite `f64` vector from an array-like.
@@ -150,14 +209,16 @@ impl PyTaskConstants {
     #[new]
     #[pyo3(signature = (gamma, r_max, m_phi, action_volume, *, constants = "thesis", horizon = None, rewards = None))]
     fn new(
-        gamma: f64,
-        r_max: f64,
-        m_phi: f64,
-        action_volume: f64,
+        gamma: &Bound<'_, PyAny>,
+        r_max: &Bound<'_, PyAny>,
+        m_phi: &Bound<'_, PyAny>,
+        action_volume: &Bound<'_, PyAny>,
         constants: &str,
         horizon: Option<&Bound<'_, PyAny>>,
         rewards: Option<&str>,
     ) -> PyResult<Self> {
+        let (gamma, r_max) = (real(gamma, "gamma")?, real(r_max, "r_max")?);
+        let (m_phi, action_volume) = (real(m_phi, "m_phi")?, real(action_volume, "action_volume")?);
         let family = family(constants, horizon, rewards)?;
         TaskConstants::new(gamma, r_max, m_phi, action_volume)
             .and_then(|k| k.with_family(family))
@@ -250,8 +311,11 @@ impl PyTaskConstants {
     /// The same constants with ψ replaced by `psi` in d(σ) (Theorem 4.3): the guarantees hold
     /// for any ψ ≥ Lemma A.1's value (`sepg.bounds.constants_psi()`), a smaller one voids
     /// them. Raises `InvalidInputError` unless `psi` is finite and positive.
-    fn with_psi(&self, psi: f64) -> PyResult<Self> {
-        self.0.with_psi(psi).map(PyTaskConstants).map_err(invalid)
+    fn with_psi(&self, psi: &Bound<'_, PyAny>) -> PyResult<Self> {
+        self.0
+            .with_psi(real(psi, "psi")?)
+            .map(PyTaskConstants)
+            .map_err(invalid)
     }
 
     /// The ψ that replaces Lemma A.1's value (`with_psi`), or `None`.
@@ -295,9 +359,11 @@ impl PyTaskConstants {
 /// The extension module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyTaskConstants>()?;
     bounds::register(m)?;
     envs::register(m)?;
+    record::register(m)?;
     runs::register(m)?;
     safe::register(m)?;
     train::register(m)?;

@@ -5,8 +5,9 @@
 use std::sync::{Arc, Mutex};
 
 use numpy::PyArray2;
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyModule;
+use pyo3::types::{PyDict, PyModule};
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
@@ -19,8 +20,9 @@ use sepg_estimators::GradientSpec;
 use sepg_mdp::rng::Stream;
 use sepg_mdp::{Batch, GaussianPolicy};
 
+use crate::record;
 use crate::safe::lengths_of;
-use crate::{PyTaskConstants, failed, floats, invalid};
+use crate::{PyTaskConstants, failed, floats, invalid, natural, real};
 
 /// The algorithm named as on the command line: `sepg-mi`, `sepg-lb1`, `sepg-lb2`, `sepg-lv`,
 /// `sepg-zv`, `sepg-sim`, `sepg-naive-w` (with `requirement`), `gpomdp-const` (with `alpha`,
@@ -209,6 +211,16 @@ impl PyCollector {
             invalid("the collector must return (rewards, actions, features, lengths)")
         })?;
         let (rewards, actions, features, lengths) = parts;
+        // features are read before the rewards they produced, so that a feature map that
+        // returns NaN is reported as such and not through the rewards of the NaN actions
+        let scored = match (r.w, r.scores) {
+            (Some(w), true) => Some((
+                w,
+                floats(&features, "features", Some(3))?,
+                floats(&actions, "actions", Some(3))?,
+            )),
+            _ => None,
+        };
         let (rw, rshape) = floats(&rewards, "rewards", Some(2))?;
         if rshape[0] != r.n {
             return Err(invalid(format!(
@@ -218,13 +230,11 @@ impl PyCollector {
         }
         let (n, h) = (rshape[0], rshape[1]);
         let lens = lengths_of(&lengths, n)?;
-        let (Some(w), true) = (r.w, r.scores) else {
+        let Some((w, (phi, fshape), (a, ashape))) = scored else {
             return Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid);
         };
         let policy =
             GaussianPolicy::new(r.v.to_vec(), w.to_vec(), self.features).map_err(invalid)?;
-        let (a, ashape) = floats(&actions, "actions", Some(3))?;
-        let (phi, fshape) = floats(&features, "features", Some(3))?;
         let (l, p) = (policy.action_dim(), self.features);
         if ashape != [n, h, l] || fshape != [n, h, p] {
             return Err(invalid(format!(
@@ -263,12 +273,14 @@ impl BatchCollector for PyCollector {
     }
 }
 
+/// The keyword arguments of [`Trainer`]'s constructor, named when an unknown one is passed.
+const TRAINER_KEYWORDS: &str = "n_trajectories, seed, delta, v0, sigma0, initial_budget, nu, requirement, alpha, beta, lr, lr_w, reference_batch, accounting, v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps";
+
 /// SEPG (Algorithm 4.3, every requirement of Table 4.1) or a comparison algorithm of
 /// Chapter 5 on trajectories collected by a Python callable. `collector(request)` receives a
 /// [`PyBatchRequest`] and returns `(rewards (N, H), actions (N, H, l), features (N, H, p),
 /// lengths (N,))` with the raw sampled actions; the scores, estimates, widths, safe steps and
-/// budget are computed in Rust. Records are returned as JSON text (one object per iteration,
-/// the fields of the run log).
+/// budget are computed in Rust. Records are returned as dicts with the columns of `log.csv`.
 #[pyclass(unsendable, name = "Trainer", module = "sepg")]
 pub struct Trainer {
     parts: Option<(PolicySolver, State)>,
@@ -292,7 +304,7 @@ impl Trainer {
     /// "A step along any direction"), which needs the tight constants and the certified
     /// accounting.
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, **unknown))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -300,13 +312,13 @@ impl Trainer {
         actions: usize,
         features: usize,
         collector: Py<PyAny>,
-        n_trajectories: usize,
-        seed: u64,
-        delta: f64,
+        n_trajectories: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        delta: Option<&Bound<'_, PyAny>>,
         v0: Option<&Bound<'_, PyAny>>,
         sigma0: Option<&Bound<'_, PyAny>>,
-        initial_budget: f64,
-        nu: f64,
+        initial_budget: Option<&Bound<'_, PyAny>>,
+        nu: Option<&Bound<'_, PyAny>>,
         requirement: &str,
         alpha: Option<f64>,
         beta: Option<f64>,
@@ -319,7 +331,20 @@ impl Trainer {
         adam_beta1: Option<f64>,
         adam_beta2: Option<f64>,
         adam_eps: Option<f64>,
+        unknown: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        if let Some(key) = unknown.and_then(|d| d.keys().iter().next()) {
+            return Err(PyTypeError::new_err(format!(
+                "Trainer() got an unexpected keyword argument {key}; its keyword arguments are {TRAINER_KEYWORDS}"
+            )));
+        }
+        // numbers are read here rather than by pyo3, so that a wrong type names the argument
+        let n_trajectories: usize =
+            n_trajectories.map_or(Ok(100), |n| natural(n, "n_trajectories"))?;
+        let seed: u64 = seed.map_or(Ok(0), |s| natural(s, "seed"))?;
+        let delta = delta.map_or(Ok(0.2), |d| real(d, "delta"))?;
+        let nu = nu.map_or(Ok(0.5), |x| real(x, "nu"))?;
+        let initial_budget = initial_budget.map_or(Ok(0.0), |b| real(b, "initial_budget"))?;
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
             .checked_mul(features)
@@ -397,10 +422,10 @@ impl Trainer {
         })
     }
 
-    /// Runs `iterations` more iterations and returns their records as JSON text. On error
-    /// the state stays after the last completed iteration; an exception of the collector is
-    /// re-raised as it is.
-    fn run(&mut self, iterations: u64) -> PyResult<String> {
+    /// Runs `iterations` more iterations and returns their records: one dict per iteration
+    /// with the columns of `log.csv` (`crate::record`). On error the state stays after the
+    /// last completed iteration; an exception of the collector is re-raised as it is.
+    fn run<'py>(&mut self, py: Python<'py>, iterations: u64) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let (solver, state) = self
             .parts
             .take()
@@ -413,7 +438,31 @@ impl Trainer {
             let stored = self.error.lock().ok().and_then(|mut s| s.take());
             return Err(stored.unwrap_or_else(|| failed(e)));
         }
-        serde_json::to_string(&log.records).map_err(failed)
+        log.records.iter().map(|r| record::to_py(py, r)).collect()
+    }
+
+    /// Replaces the state by `state`, JSON text as `state()` returns it (the checkpoint of a
+    /// saved model). Raises `InvalidInputError` for text that is not such a state, or a state
+    /// whose v and w do not have the trainer's dimensions; the trainer is unchanged then.
+    fn set_state(&mut self, state: &str) -> PyResult<()> {
+        let new: State = serde_json::from_str(state).map_err(|e| invalid(format!("state: {e}")))?;
+        let (solver, old) = self
+            .parts
+            .take()
+            .ok_or_else(|| failed("the trainer is unusable after an internal error"))?;
+        if new.v.len() != old.v.len() || new.w.len() != old.w.len() {
+            let message = format!(
+                "state: v and w must have {} and {} entries, got {} and {}",
+                old.v.len(),
+                old.w.len(),
+                new.v.len(),
+                new.w.len()
+            );
+            self.parts = Some((solver, old));
+            return Err(invalid(message));
+        }
+        self.parts = Some((solver, new));
+        Ok(())
     }
 
     /// The state after the last completed iteration (the checkpoint), as JSON text.

@@ -2,7 +2,6 @@
 ("Tight constants"), checked against the printed formulas c = rho R M_phi^2 S_H / sigma^2 and
 d = 2 rho R S_H written out here, and a Trainer's step under each family."""
 
-import json
 import math
 
 import numpy as np
@@ -85,7 +84,7 @@ def test_a_trainer_step_with_tight_constants_is_larger_by_the_ratio_of_c():
     steps = {}
     for name, k in [("thesis", thesis), ("tight", tight)]:
         trainer = sepg.Trainer("sepg-mi", k, 1, 1, collector, n_trajectories=400)
-        steps[name] = json.loads(trainer.run(1))[0]["alpha"]
+        steps[name] = trainer.run(1)[0]["alpha"]
     c_thesis = thesis_c(gamma, r, m, vol, sigma)
     c_tight = r * m * m * s_h_closed(gamma, 2) / sigma**2  # S_2 = 1 + 2 gamma
     assert steps["thesis"] > 0

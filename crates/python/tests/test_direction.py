@@ -3,7 +3,6 @@ sepg.direction_safe_step against the largest t with
 B(t) = t (u.g) - t sum |u_i| eps_i - c kappa t^2 |u|^2 >= C, solved here in closed form with
 c = rho R M_phi^2 S_H / sigma^2 written out; and safe Adam in a Trainer."""
 
-import json
 import math
 
 import numpy as np
@@ -136,7 +135,7 @@ def test_a_trainer_runs_safe_adam_and_refuses_it_where_unproven():
     trainer = sepg.Trainer(
         "sepg-mi", k, 1, 1, collector, n_trajectories=400, v0=[0.5], v_direction="adam", adam_lr=lr
     )
-    records = json.loads(trainer.run(5))
+    records = trainer.run(5)
     assert len(records) == 5
     v = [0.5] + [r["v"][0] for r in records]
     # Adam's first change is lr sign(g), and t <= 1: no change is longer than lr

@@ -15,6 +15,11 @@
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 //! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
 //! | [`SepgOptions::constants`] | [`ConstantsFamily::Thesis`] (`sepg run`: tight) | [`ConstantsFamily::Thesis`] |
+//!
+//! Serialised (the `options` of a run's `summary.json`), every choice is named in kebab-case as
+//! in `config.toml` (`"cross-fitted"`, `{"student-t": {"factor": 2.0}}`, `"theorem-4.9"`); the
+//! PascalCase names that older summaries wrote (`"CrossFitted"`, `{"StudentT": …}`) are read
+//! as well.
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use serde::{Deserialize, Serialize};
 
@@ -22,29 +27,36 @@ use crate::core::error::ConfigError;
 
 /// How the w-update turns its estimates into a safe step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum WStep {
     /// The exploring w-update (docs/THEOREMS.md, `sepg_bounds::exploring`): the step goes
     /// as far along the chosen direction as the bound of Theorem 4.3 with the confidence on
     /// ∇_w J alone allows. The width of the direction's estimate plays no role.
     #[default]
+    #[serde(alias = "Exploring")]
     Exploring,
     /// Theorem 4.9 in the sign-aware form: corrected norms L⁻J⁻, no update when the direction
     /// is within its confidence width (eq. 4.23).
+    #[serde(rename = "theorem-4.9", alias = "Theorem49")]
     Theorem49,
 }
 
 /// The direction of the w-update.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum WDirection {
     /// ∇̂_w L, cross-fitted on two halves of the batch (unbiased, `sepg_estimators`).
     #[default]
+    #[serde(alias = "CrossFitted")]
     CrossFitted,
     /// ∇̂_w L from full-batch plug-in products ‖∇̂_v J‖² and ⟨∇̂_v J, ∂̂_σ∇_v J⟩, biased
     /// upwards by the variance of ∇̂_v J.
+    #[serde(alias = "PlugIn")]
     PlugIn,
     /// The thesis-era code's direction: the w-derivative of J + α‖∇_v J‖² with α the step
     /// size of the latest v-update (scalar actions only):
     /// `∇̂_w J + 2α‖∇̂_v J‖² + clip(2σα⟨∇̂_v J, ∂̂_σ∇_v J⟩, ±clip)`.
+    #[serde(alias = "Metagradient")]
     Metagradient {
         /// The clipping threshold of the last term (100 in the thesis-era code).
         clip: f64,
@@ -53,6 +65,7 @@ pub enum WDirection {
 
 /// The confidence widths ε of the sampled mode (Section 4.5).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Confidence {
     /// Widths proven at every batch size from the task's constants R, M_φ, σ, γ and H
     /// (`sepg_estimators::proven`, docs/THEOREMS.md "Proven confidence widths"): the
@@ -60,10 +73,13 @@ pub enum Confidence {
     /// ε_i is the sub-Gaussian (∇_v J) or sub-exponential (∇_w J) width of that estimator. The
     /// direction ∇̂_w L, which carries no guarantee, keeps Student-t widths.
     #[default]
+    #[serde(alias = "SubGaussian")]
     SubGaussian,
     /// ε = 0: the estimates are used as if exact (the thesis-era code's default δ = 1).
+    #[serde(alias = "None")]
     None,
     /// ε_i = factor · t(1 − δ/2, N − 1) · √(Var_i/N); the thesis-era code used factor 2.
+    #[serde(alias = "StudentT")]
     StudentT {
         /// Multiplier of the Student-t quantile (> 0).
         factor: f64,
@@ -90,29 +106,35 @@ impl Confidence {
 
 /// How LB-I's requirement C = J(θ⁰) − J is shared between the two half-steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Lb1Requirement {
     /// (1 − ν)Cᵗ for the v-update and νCᵗ for the w-update, Cᵗ = J(θ⁰) − J(θᵗ)
     /// (eqs. 4.13, 4.14).
     #[default]
+    #[serde(alias = "Split")]
     Split,
     /// Each half-step gets the whole requirement measured at its own start:
     /// J(θ⁰) − J(vᵗ, wᵗ) for the v-update, J(θ⁰) − J(vᵗ⁺¹, wᵗ) for the w-update.
+    #[serde(alias = "Full")]
     Full,
 }
 
 /// What the safety requirements are built on (docs/THEOREMS.md, "Statements over a whole
 /// run").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Accounting {
     /// Certified quantities only: LB-I's surplus and the type-II budget are sums of the
     /// guaranteed improvements of the steps actually applied (each the certified lower end
     /// of its bound), rounded down; on the confidence events they are lower bounds of
     /// J(θᵗ) − J(θ⁰), so every requirement holds against exact J. No estimate of J enters.
     #[default]
+    #[serde(alias = "Certified")]
     Certified,
     /// The thesis's bookkeeping (Sec 4.4.4): LB-I's J(θ⁰) − Ĵᵗ and the budget's measured
     /// differences of estimated J (with the reference batch's upper bound Û⁰). Kept for
     /// reproduction; it carries no statement about exact J.
+    #[serde(alias = "Estimated")]
     Estimated,
 }
 
@@ -125,16 +147,19 @@ impl Accounting {
 
 /// The direction of the v-update.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum VDirection {
     /// The greedy coordinate of Theorem 4.2 / eq. (4.11): the coordinate of the largest
     /// |∇̂_{v_k}J|, with the largest safe step along it.
     #[default]
+    #[serde(alias = "Greedy")]
     Greedy,
     /// "Safe Adam": Adam (Kingma and Ba 2015) proposes the change u from its moments of the
     /// v-gradient estimates, and the applied change is t·u with t = min(1, the largest t whose
     /// bound along u meets the v-block's requirement) (`sepg_bounds::direction`,
     /// docs/THEOREMS.md "A step along any direction"): never longer than Adam's own change.
     /// Proven with the tight constants only (Theorem T); the certified accounting only.
+    #[serde(alias = "Adam")]
     Adam {
         /// Learning rate (> 0, units of v per step).
         lr: f64,
@@ -173,14 +198,17 @@ impl VDirection {
 
 /// How the confidence δ is spread over the confidence statements of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Schedule {
     /// Over the whole run: iteration t of T gets δ/T, split evenly over its K scalar
     /// confidence statements (every component of every estimated gradient a guarantee rests
     /// on), so that by the union bound P(any statement of the run fails) ≤ δ.
     #[default]
+    #[serde(alias = "Run")]
     Run,
     /// Every width at level δ (the thesis): each iteration's requirement holds with
     /// probability about 1 − δ, not the whole run's.
+    #[serde(alias = "Iteration")]
     Iteration,
 }
 
@@ -193,11 +221,14 @@ impl Schedule {
 
 /// What is known of the sign of every reward r_t of a task (|r_t| ≤ R always).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum RewardSign {
     /// Rewards of either sign: the two-sided tight constants (ρ = 1). Always sound.
+    #[serde(alias = "TwoSided")]
     TwoSided,
     /// −R ≤ r_t ≤ 0 for every t (the LQG presets, whose reward −(sᵀQs + aᵀRa) has Q and R
     /// positive semi-definite): the tight constants halve (ρ = 1/2).
+    #[serde(alias = "NonPositive")]
     NonPositive,
 }
 
@@ -214,12 +245,15 @@ impl RewardSign {
 /// The family of constants that gives the penalty coefficients c(σ) and d(σ) of every bound
 /// of a run (docs/THEOREMS.md, "Tight constants").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ConstantsFamily {
     /// c of Theorems 3.14 / 4.2 and d of Theorem 4.3 (the thesis).
     #[default]
+    #[serde(alias = "Thesis")]
     Thesis,
     /// The tight constants c = ρ R M_φ² S_H / σ² and d = 2ρ R S_H of Theorem T, with S_H for
     /// the run's horizon H ([`crate::core::config::SepgConfig::horizon`]).
+    #[serde(alias = "Tight")]
     Tight {
         /// What is known of the rewards' sign (ρ = 1 two-sided, 1/2 non-positive).
         rewards: RewardSign,
@@ -426,5 +460,116 @@ impl SepgOptions {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Options with a choice of every serialised enum off its default.
+    fn varied() -> SepgOptions {
+        SepgOptions {
+            w_step: WStep::Theorem49,
+            w_direction: WDirection::Metagradient { clip: 100.0 },
+            confidence: Confidence::StudentT { factor: 2.0 },
+            lb1_requirement: Lb1Requirement::Full,
+            accounting: Accounting::Certified,
+            schedule: Schedule::Iteration,
+            v_direction: VDirection::adam(0.01),
+            constants: ConstantsFamily::Tight {
+                rewards: RewardSign::NonPositive,
+            },
+            ..SepgOptions::default()
+        }
+    }
+
+    #[test]
+    fn options_serialise_in_the_kebab_case_of_config_toml() {
+        let json = serde_json::to_value(varied()).expect("serialise");
+        let expected = serde_json::json!({
+            "w_step": "theorem-4.9",
+            "w_direction": {"metagradient": {"clip": 100.0}},
+            "confidence": {"student-t": {"factor": 2.0}},
+            "lb1_requirement": "full",
+            "accounting": "certified",
+            "schedule": "iteration",
+            "v_direction": {"adam": {"lr": 0.01, "beta1": 0.9, "beta2": 0.999, "eps": 1e-8}},
+            "constants": {"tight": {"rewards": "non-positive"}},
+        });
+        for (key, value) in expected.as_object().expect("object") {
+            assert_eq!(&json[key], value, "{key}");
+        }
+        let plain = serde_json::to_value(SepgOptions::default()).expect("serialise");
+        assert_eq!(plain["w_direction"], "cross-fitted");
+        assert_eq!(plain["confidence"], "sub-gaussian");
+        assert_eq!(plain["w_step"], "exploring");
+    }
+
+    #[test]
+    fn options_of_older_summaries_in_pascal_case_are_read() {
+        let old = serde_json::json!({
+            "w_step": "Theorem49",
+            "w_direction": {"Metagradient": {"clip": 100.0}},
+            "confidence": {"StudentT": {"factor": 2.0}},
+            "lb1_requirement": "Full",
+            "alternating": false,
+            "reference_batch": 1000,
+            "overrides": {"gamma": null, "r_max": null, "m_phi": null, "action_volume": null,
+                          "psi": null},
+            "accounting": "Certified",
+            "schedule": "Iteration",
+            "v_direction": {"Adam": {"lr": 0.01, "beta1": 0.9, "beta2": 0.999, "eps": 1e-8}},
+            "constants": {"Tight": {"rewards": "NonPositive"}},
+        });
+        let read: SepgOptions = serde_json::from_value(old).expect("old names");
+        assert_eq!(read, varied());
+        for (text, expected) in [
+            ("\"CrossFitted\"", WDirection::CrossFitted),
+            ("\"PlugIn\"", WDirection::PlugIn),
+        ] {
+            assert_eq!(
+                serde_json::from_str::<WDirection>(text).expect("old"),
+                expected
+            );
+        }
+        for (text, expected) in [
+            ("\"SubGaussian\"", Confidence::SubGaussian),
+            ("\"None\"", Confidence::None),
+            ("\"none\"", Confidence::None),
+        ] {
+            assert_eq!(
+                serde_json::from_str::<Confidence>(text).expect("old"),
+                expected
+            );
+        }
+        assert_eq!(
+            serde_json::from_str::<ConstantsFamily>("\"Thesis\"").expect("old"),
+            ConstantsFamily::Thesis
+        );
+        assert_eq!(
+            serde_json::from_str::<RewardSign>("\"TwoSided\"").expect("old"),
+            RewardSign::TwoSided
+        );
+        assert_eq!(
+            serde_json::from_str::<Accounting>("\"Estimated\"").expect("old"),
+            Accounting::Estimated
+        );
+        assert_eq!(
+            serde_json::from_str::<Schedule>("\"Run\"").expect("old"),
+            Schedule::Run
+        );
+        assert_eq!(
+            serde_json::from_str::<WStep>("\"Exploring\"").expect("old"),
+            WStep::Exploring
+        );
+        assert_eq!(
+            serde_json::from_str::<Lb1Requirement>("\"Split\"").expect("old"),
+            Lb1Requirement::Split
+        );
+        assert_eq!(
+            serde_json::from_str::<VDirection>("\"Greedy\"").expect("old"),
+            VDirection::Greedy
+        );
     }
 }

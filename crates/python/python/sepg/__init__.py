@@ -8,6 +8,9 @@
 - :mod:`sepg.gym`: SEPG and the comparison algorithms on any gymnasium environment with a
   ``Box`` action space (imported on demand; needs ``gymnasium``).
 - :class:`Trainer`: the same algorithms on batches collected by any Python callable.
+- :class:`SEPG`: a model object with stable-baselines3's ``learn``/``predict``/``save``/
+  ``load`` on a gymnasium environment; :mod:`sepg.callbacks` and :mod:`sepg.logger` serve it
+  and :mod:`sepg.gym`.
 - :mod:`sepg.runs`: run folders, sweeps (mapped over Dask or Ray), merges and audits of the
   built-in environments, as the command line writes them.
 
@@ -24,6 +27,7 @@ if TYPE_CHECKING:
     from typing import Any, Dict, Optional, Sequence, Tuple
 
 from sepg import bounds, errors, runs
+from sepg._native import __version__
 from sepg._native import (
     mountain_car_trajectory,
     BatchRequest,
@@ -70,6 +74,9 @@ def required_improvement(
         )
     import math
 
+    for name, value in (("budget", budget), ("nu", nu), ("j_initial", j_initial), ("j_current", j_current)):
+        if value is not None and (isinstance(value, (bool, str, complex)) or not hasattr(value, "__float__")):
+            raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
     if not math.isfinite(budget) or budget < 0.0:
         raise InvalidInputError(f"budget = {budget} must be finite and non-negative")
     if requirement == "mi":
@@ -85,10 +92,11 @@ def required_improvement(
 
 
 def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, Any]:
-    """Per-iteration records (dicts with the fields of the run log) as one numpy array per
-    field: floats, integers and booleans as typed arrays, vectors as 2-D arrays (one row
-    per iteration), and fields that are sometimes absent as object arrays holding ``None``
-    where absent (never NaN)."""
+    """Per-iteration records (dicts with the columns of ``log.csv``: ``j_explore``,
+    ``required``, ...) as one numpy array per field: floats, integers and booleans as typed
+    arrays, vectors as 2-D arrays (one row per iteration; the deterministic target's
+    ``w_target`` is -inf, as in the file), and fields that are sometimes absent as object
+    arrays holding ``None`` where absent (never NaN)."""
     import numpy as np
 
     if not records:
@@ -112,9 +120,15 @@ def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, Any]:
     return out
 
 
+def _column(key: str, j: int, n: int) -> str:
+    """The column of ``log.csv`` for component ``j`` of the vector ``key`` of length ``n``."""
+    return key if n == 1 else f"{key}_{j}"
+
+
 def records_to_pandas(records: Sequence[Dict[str, Any]]) -> Any:
-    """The records as a pandas DataFrame (needs pandas): vectors are split into one column
-    per component (``v_0``, ``v_1``, ...), absent values are ``pd.NA`` in nullable columns."""
+    """The records as a pandas DataFrame (needs pandas) with the columns of ``log.csv``:
+    vectors are split into one column per component (``v_0``, ``v_1``, ..., or ``v`` alone for
+    one component), absent values are ``pd.NA`` in nullable columns."""
     import numpy as np
     import pandas as pd
 
@@ -124,7 +138,7 @@ def records_to_pandas(records: Sequence[Dict[str, Any]]) -> Any:
             first = next((v for v in column if v is not None), None)
             if isinstance(first, np.ndarray):
                 for j in range(first.shape[0]):
-                    columns[f"{key}_{j}"] = pd.array(
+                    columns[_column(key, j, first.shape[0])] = pd.array(
                         [None if v is None else float(v[j]) for v in column], dtype="Float64"
                     )
             else:
@@ -133,10 +147,20 @@ def records_to_pandas(records: Sequence[Dict[str, Any]]) -> Any:
                 )
         elif column.ndim == 2:
             for j in range(column.shape[1]):
-                columns[f"{key}_{j}"] = column[:, j]
+                columns[_column(key, j, column.shape[1])] = column[:, j]
         else:
             columns[key] = column
     return pd.DataFrame(columns)
+
+
+def __getattr__(name: str) -> Any:
+    # sepg.SEPG needs numpy and gymnasium: imported when first used, so that ``import sepg``
+    # stays cheap
+    if name == "SEPG":
+        from sepg.model import SEPG
+
+        return SEPG
+    raise AttributeError(f"module 'sepg' has no attribute {name!r}")
 
 
 __all__ = [
@@ -146,6 +170,7 @@ __all__ = [
     "InvalidInputError",
     "MissingConstantError",
     "RunFailedError",
+    "SEPG",
     "SafeStep",
     "SepgError",
     "StepOutcome",
@@ -164,4 +189,5 @@ __all__ = [
     "runs",
     "v_step",
     "w_step",
+    "__version__",
 ]

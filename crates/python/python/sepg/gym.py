@@ -32,6 +32,9 @@ import numpy as np
 from sepg._native import BatchRequest, TaskConstants, Trainer
 from sepg.errors import InvalidInputError, MissingConstantError
 from sepg import records_to_arrays, records_to_pandas
+from sepg.callbacks import CallbackArg, as_callback
+from sepg._progress import progress_bar as _progress_bar
+from sepg.logger import Logger
 
 Features = Callable[[np.ndarray], Any]
 
@@ -153,6 +156,10 @@ class _Collector:
             raise InvalidInputError(
                 f"features returned {phi.shape[0]} values, earlier {self.n_features}"
             )
+        if not np.all(np.isfinite(phi)):
+            raise InvalidInputError(
+                f"features must be finite: features({np.asarray(obs).tolist()}) = {phi.tolist()}"
+            )
         return phi
 
     def __call__(self, req: BatchRequest) -> Tuple[np.ndarray, Optional[np.ndarray], Optional[np.ndarray], np.ndarray]:
@@ -242,8 +249,8 @@ class GymRun:
     observation to the feature vector phi(s) (default: the observation itself). ``algorithm``
     is named as on the command line (``sepg-zv``, ``sepg-lv``, ``sepg-mi``, ``sepg-lb1``,
     ``sepg-lb2``, ``sepg-sim``, ``sepg-naive-w``, ``gpomdp-const``, ``gpomdp-adam``,
-    ``adastep``); ``options`` are its hyper-parameters (``nu``, ``requirement``, ``alpha``,
-    ``beta``, ``lr``, ``lr_w``), ``accounting`` (``"certified"``, the default: requirements
+    ``adastep``); its hyper-parameters are ``nu``, ``requirement``, ``alpha``, ``beta``,
+    ``lr`` and ``lr_w`` (as :class:`sepg.Trainer`'s); ``accounting`` (``"certified"``, the default: requirements
     built on the certified guarantees of the applied steps; ``"estimated"``: the thesis's
     bookkeeping) and ``reference_batch``, the N0 trajectories that estimate J(theta^0) before
     SEPG's first iteration under the estimated bookkeeping (default 1000; 0 takes it from the
@@ -256,6 +263,10 @@ class GymRun:
     ``"thesis"`` (Theorems 3.14, 4.2 and 4.3). A gymnasium environment states nothing about
     the sign of its rewards, so the tight constants are two-sided (rho = 1) unless
     ``rewards="non-positive"`` says that every reward lies in [-R_max, 0] (rho = 1/2).
+
+    :meth:`run` runs iterations with optional callbacks (:mod:`sepg.callbacks`), a progress
+    bar and a logger (:class:`sepg.logger.Logger`); ``records`` holds one dict per iteration
+    with the columns of ``log.csv``.
     """
 
     def __init__(
@@ -278,7 +289,19 @@ class GymRun:
         show_derivation: bool = True,
         constants: str = "tight",
         rewards: Optional[str] = None,
-        **options: Any,
+        nu: float = 0.5,
+        requirement: str = "zv",
+        alpha: Optional[float] = None,
+        beta: Optional[float] = None,
+        lr: Optional[float] = None,
+        lr_w: Optional[float] = None,
+        reference_batch: Optional[int] = None,
+        accounting: str = "certified",
+        v_direction: str = "greedy",
+        adam_lr: Optional[float] = None,
+        adam_beta1: Optional[float] = None,
+        adam_beta2: Optional[float] = None,
+        adam_eps: Optional[float] = None,
     ) -> None:
         gymnasium = _gymnasium()
         if isinstance(env, str):
@@ -305,8 +328,9 @@ class GymRun:
                 raise InvalidInputError(
                     f"{_name(env)} has no max_episode_steps: pass horizon"
                 )
-        if not isinstance(horizon, int) or horizon < 1:
+        if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise InvalidInputError(f"horizon must be a positive integer, got {horizon!r}")
+        horizon = int(horizon)
         self.constants = self.constants.with_family(
             constants,
             horizon=horizon if constants == "tight" else None,
@@ -328,6 +352,7 @@ class GymRun:
         if phi.shape[0] == 0:
             raise InvalidInputError("features must return at least one value")
         self.n_features = int(phi.shape[0])
+        self.algorithm = algorithm
         self.collector = _Collector(env, features, horizon, self.actions, self.n_features)
         self.trainer = Trainer(
             algorithm,
@@ -338,20 +363,87 @@ class GymRun:
             n_trajectories=n_trajectories,
             seed=seed,
             delta=delta,
-            v0=None if v0 is None else np.asarray(v0, dtype=float),
-            sigma0=None if sigma0 is None else np.asarray(sigma0, dtype=float),
+            v0=v0,
+            sigma0=sigma0,
             initial_budget=initial_budget,
-            **options,
+            nu=nu,
+            requirement=requirement,
+            alpha=alpha,
+            beta=beta,
+            lr=lr,
+            lr_w=lr_w,
+            reference_batch=reference_batch,
+            accounting=accounting,
+            v_direction=v_direction,
+            adam_lr=adam_lr,
+            adam_beta1=adam_beta1,
+            adam_beta2=adam_beta2,
+            adam_eps=adam_eps,
         )
         self.records: List[Dict[str, Any]] = []
 
-    def run(self, iterations: int) -> Dict[str, np.ndarray]:
-        """Runs ``iterations`` more iterations; returns every record so far as arrays
-        (:func:`sepg.records_to_arrays`)."""
-        if not isinstance(iterations, int) or iterations < 0:
-            raise InvalidInputError(f"iterations must be a non-negative integer, got {iterations!r}")
-        self.records.extend(json.loads(self.trainer.run(iterations)))
+    def run(
+        self,
+        iterations: Optional[int] = None,
+        *,
+        total_timesteps: Optional[int] = None,
+        callback: CallbackArg = None,
+        progress_bar: Optional[bool] = None,
+        logger: Optional[Logger] = None,
+    ) -> Dict[str, np.ndarray]:
+        """Runs ``iterations`` more iterations, or (``total_timesteps``) iterations until
+        this call has used at least that many more environment steps (as stable-baselines3's
+        ``learn``; the ``steps`` column counts the run's steps in all); returns every record
+        so far as arrays (:func:`sepg.records_to_arrays`). An exception (of the environment,
+        the features or a callback, or Ctrl-C) leaves the run after its last complete
+        iteration, whose record is kept.
+
+        ``callback`` is called once per iteration with the iteration's record (see
+        :mod:`sepg.callbacks`); when it returns ``False`` the run stops after that
+        iteration, which is complete and kept. ``progress_bar`` shows a tqdm bar on standard
+        error (default: when standard error is a terminal). ``logger`` (a
+        :class:`sepg.logger.Logger`) receives every record."""
+        if (iterations is None) == (total_timesteps is None):
+            raise InvalidInputError("pass either iterations or total_timesteps")
+        goal = iterations if iterations is not None else total_timesteps
+        name = "iterations" if iterations is not None else "total_timesteps"
+        if isinstance(goal, bool) or not isinstance(goal, (int, np.integer)) or goal < 0:
+            raise InvalidInputError(f"{name} must be a non-negative integer, got {goal!r}")
+        goal = int(goal)
+        hooks = as_callback(callback)
+        by_steps = total_timesteps is not None
+        start_steps = self._steps()
+        bar = _progress_bar(
+            progress_bar,
+            total=goal,
+            unit="step" if by_steps else "it",
+            desc=f"{self.algorithm} on {_name(self.env)}",
+        )
+        if hooks is not None:
+            hooks.on_training_start(self)
+        done = 0
+        try:
+            while done < goal:
+                record = self.trainer.run(1)[0]
+                self.records.append(record)
+                done = done + 1 if not by_steps else int(record["steps"]) - start_steps
+                if logger is not None:
+                    logger.record(record)
+                if bar is not None:
+                    bar.update(min(done, goal) - bar.n)
+                    bar.set_postfix(j_explore=f"{record['j_explore']:.4g}", refresh=False)
+                if hooks is not None and not hooks.on_step(record):
+                    break
+        finally:
+            if bar is not None:
+                bar.close()
+            if hooks is not None:
+                hooks.on_training_end()
         return records_to_arrays(self.records)
+
+    def _steps(self) -> int:
+        """Environment steps the run has used so far."""
+        return int(self.state["steps"])
 
     @property
     def state(self) -> Dict[str, Any]:
@@ -378,11 +470,80 @@ class GymRun:
         return records_to_pandas(self.records)
 
 
-def train(env: Any, features: Optional[Features] = None, *, iterations: int, **kwargs: Any) -> GymRun:
-    """Builds a :class:`GymRun` and runs ``iterations`` iterations; returns the run (its
-    ``records``, ``mean``, ``sigma``, ``derivation``, ``steps_per_second``)."""
-    run = GymRun(env, features, **kwargs)
-    run.run(iterations)
+def train(
+    env: Any,
+    features: Optional[Features] = None,
+    *,
+    iterations: int,
+    gamma: float,
+    algorithm: str = "sepg-zv",
+    n_trajectories: int = 100,
+    horizon: Optional[int] = None,
+    r_max: Optional[float] = None,
+    m_phi: Optional[float] = None,
+    action_volume: Optional[float] = None,
+    seed: int = 0,
+    delta: float = 0.2,
+    v0: Optional[Sequence[float]] = None,
+    sigma0: Optional[Sequence[float]] = None,
+    initial_budget: float = 0.0,
+    show_derivation: bool = True,
+    constants: str = "tight",
+    rewards: Optional[str] = None,
+    nu: float = 0.5,
+    requirement: str = "zv",
+    alpha: Optional[float] = None,
+    beta: Optional[float] = None,
+    lr: Optional[float] = None,
+    lr_w: Optional[float] = None,
+    reference_batch: Optional[int] = None,
+    accounting: str = "certified",
+    v_direction: str = "greedy",
+    adam_lr: Optional[float] = None,
+    adam_beta1: Optional[float] = None,
+    adam_beta2: Optional[float] = None,
+    adam_eps: Optional[float] = None,
+    callback: CallbackArg = None,
+    progress_bar: Optional[bool] = None,
+    logger: Optional[Logger] = None,
+) -> GymRun:
+    """Builds a :class:`GymRun` (every argument but the last three is the constructor's) and
+    runs ``iterations`` iterations with ``callback``, ``progress_bar`` and ``logger`` as
+    :meth:`GymRun.run`; returns the run (its ``records``, ``mean``, ``sigma``,
+    ``derivation``, ``steps_per_second``)."""
+    run = GymRun(
+        env,
+        features,
+        gamma=gamma,
+        algorithm=algorithm,
+        n_trajectories=n_trajectories,
+        horizon=horizon,
+        r_max=r_max,
+        m_phi=m_phi,
+        action_volume=action_volume,
+        seed=seed,
+        delta=delta,
+        v0=v0,
+        sigma0=sigma0,
+        initial_budget=initial_budget,
+        show_derivation=show_derivation,
+        constants=constants,
+        rewards=rewards,
+        nu=nu,
+        requirement=requirement,
+        alpha=alpha,
+        beta=beta,
+        lr=lr,
+        lr_w=lr_w,
+        reference_batch=reference_batch,
+        accounting=accounting,
+        v_direction=v_direction,
+        adam_lr=adam_lr,
+        adam_beta1=adam_beta1,
+        adam_beta2=adam_beta2,
+        adam_eps=adam_eps,
+    )
+    run.run(iterations, callback=callback, progress_bar=progress_bar, logger=logger)
     return run
 
 
