@@ -13,9 +13,10 @@ use sepg_mdp::oracle::ClosedFormOracle;
 use crate::check::{
     Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Tolerance, fmt_f64,
 };
-use crate::checks::sampled::{Freq, frequency_outcome};
+use crate::checks::sampled::FAMILY_ALPHA;
 use crate::lqg::{HORIZON, Preset, Task};
 use crate::search::{Comparison, fixed};
+use crate::stats::{Freq, frequency_outcome};
 
 fn env(preset: Preset, clipped: bool) -> Option<AnyEnv> {
     let model = match preset {
@@ -330,7 +331,7 @@ fn sampled_violations(ctx: &CheckContext<'_>) -> Evaluation {
             });
         }
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {

@@ -8,8 +8,10 @@ use sepg_bounds::high_probability::{HpForm, w_safe_step_along_l};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_estimators::{Estimator, GradientSpec, Param, SurrogateEstimate, Width};
 
-use super::sampled::{DP_TRUTH, Freq, N, Setting, estimate, frequency_outcome, hp_settings, meta};
+use super::sampled::{DP_TRUTH, FAMILY_ALPHA, N, estimate, hp_settings, meta};
 use crate::check::{Check, CheckContext, Evaluation, Figure};
+use crate::lqg::Setting;
+use crate::stats::{Freq, frequency_outcome};
 
 /// Confidence parameter of every width of the check.
 const DELTA: f64 = 0.2;
@@ -126,7 +128,7 @@ fn exploring_w_step(ctx: &CheckContext<'_>) -> Evaluation {
             });
         }
     }
-    let mut evaluation = frequency_outcome(&tests);
+    let mut evaluation = frequency_outcome(&tests, FAMILY_ALPHA);
     evaluation.figures.extend(figures);
     evaluation
 }

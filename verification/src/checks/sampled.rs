@@ -11,17 +11,13 @@ use std::fmt::Write as _;
 
 use proptest::prelude::*;
 use sepg_bounds::batch_size;
-use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::pirotta::{self, AdaptiveStep};
 use sepg_estimators::{
-    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Kind, Param, SurrogateEstimate,
-    Width, normal_quantile,
+    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Kind, Param, SurrogateEstimate, Width,
 };
 use sepg_mdp::Batch;
-use sepg_mdp::env::LqgEnv;
-use sepg_mdp::oracle::ExactEval;
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::rollout;
@@ -30,208 +26,15 @@ use crate::check::{
     Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Outcome, Tolerance,
     fmt_f64,
 };
+use crate::lqg::Setting;
 use crate::lqg::{HORIZON, Preset, Task};
 use crate::search::{Comparison, search};
-use crate::stats::{clopper_pearson_lower, clopper_pearson_upper};
+use crate::stats::{
+    Freq, ZTest, clopper_pearson_lower, clopper_pearson_upper, frequency_outcome, z_outcome,
+};
 
-/// Family-wise false-alarm rate of every statistical check in this module.
-const FAMILY_ALPHA: f64 = 1e-3;
-
-/// A policy on a preset, with its exact values, rollouts and estimators.
-pub(crate) struct Setting {
-    pub(crate) task: Task,
-    env: LqgEnv,
-    policy: GaussianPolicy,
-    pub(crate) v: f64,
-    pub(crate) w: f64,
-    pub(crate) sigma: f64,
-    pub(crate) exact: ExactEval,
-}
-
-impl Setting {
-    pub(crate) fn new(
-        preset: Preset,
-        gamma: f64,
-        sigma: f64,
-        v: f64,
-        clipped: bool,
-    ) -> Option<Self> {
-        let task = if clipped {
-            Task::new(preset, gamma)?
-        } else {
-            Task::unclipped(preset, gamma)?
-        };
-        let env = task.env()?;
-        let w = sigma.ln();
-        let exact = task.eval(v, w)?;
-        Some(Self {
-            policy: GaussianPolicy::scalar(v, w).ok()?,
-            task,
-            env,
-            v,
-            w,
-            sigma,
-            exact,
-        })
-    }
-
-    pub(crate) fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
-        rollout(
-            &self.env,
-            &self.policy,
-            n,
-            HORIZON,
-            SeedKey::new(seed, index, 0),
-        )
-        .ok()
-    }
-
-    pub(crate) fn k(&self) -> &TaskConstants {
-        &self.task.k
-    }
-}
-
-/// One binomial test: `violations` out of `trials`, claimed rate at most `allowed`.
-pub(crate) struct Freq {
-    pub(crate) name: String,
-    pub(crate) violations: u64,
-    pub(crate) trials: u64,
-    pub(crate) allowed: f64,
-}
-
-/// Clopper–Pearson test of every [`Freq`] at family-wise level [`FAMILY_ALPHA`] (Bonferroni):
-/// a claim is rejected when the one-sided lower confidence bound on its violation rate exceeds
-/// the allowed rate.
-pub(crate) fn frequency_outcome(tests: &[Freq]) -> Evaluation {
-    let confidence = 1.0 - FAMILY_ALPHA / tests.len().max(1) as f64;
-    let mut figures = Vec::new();
-    let mut worst: Option<(f64, String)> = None;
-    let (mut margin, mut relative) = (f64::INFINITY, f64::INFINITY);
-    let mut trials = 0;
-    for t in tests.iter().filter(|t| t.trials > 0) {
-        trials += t.trials;
-        let rate = t.violations as f64 / t.trials as f64;
-        let (Ok(lo), Ok(hi)) = (
-            clopper_pearson_lower(t.violations, t.trials, confidence),
-            clopper_pearson_upper(t.violations, t.trials, 0.95),
-        ) else {
-            continue;
-        };
-        figures.push(Figure {
-            name: t.name.clone(),
-            value: format!(
-                "{}/{} violations, rate {}, 95% upper bound {}, allowed {}",
-                t.violations,
-                t.trials,
-                fmt_f64(rate),
-                fmt_f64(hi),
-                fmt_f64(t.allowed)
-            ),
-        });
-        if lo > t.allowed {
-            let amount = rate - t.allowed;
-            if worst.as_ref().is_none_or(|(a, _)| amount > *a) {
-                worst = Some((
-                    amount,
-                    format!(
-                        "{}: {}/{} violations (rate {}, one-sided {} lower bound {}) > allowed {}",
-                        t.name,
-                        t.violations,
-                        t.trials,
-                        fmt_f64(rate),
-                        fmt_f64(confidence),
-                        fmt_f64(lo),
-                        fmt_f64(t.allowed)
-                    ),
-                ));
-            }
-        }
-        margin = margin.min(t.allowed - rate);
-        relative = relative.min((t.allowed - rate) / t.allowed);
-    }
-    let outcome = match worst {
-        Some((amount, counterexample)) => Outcome::Violated {
-            counterexample,
-            amount,
-        },
-        None if trials == 0 => Outcome::Inconclusive {
-            reason: "no informative trial".into(),
-        },
-        None => Outcome::HoldsWithMargin {
-            margin,
-            relative_margin: relative,
-        },
-    };
-    Evaluation {
-        outcome,
-        cases: trials,
-        figures,
-    }
-}
-
-/// One z-test of an unbiasedness claim: the mean of `samples` (independent batch estimates)
-/// against the exact value.
-struct ZTest {
-    name: String,
-    samples: Vec<f64>,
-    truth: f64,
-}
-
-fn z_outcome(tests: &[ZTest]) -> Evaluation {
-    let m = tests.len().max(1) as f64;
-    let z_crit = normal_quantile(1.0 - FAMILY_ALPHA / (2.0 * m)).unwrap_or(f64::INFINITY);
-    let mut figures = vec![Figure {
-        name: "critical |z| (two-sided, Bonferroni)".into(),
-        value: fmt_f64(z_crit),
-    }];
-    let mut max_error = 0.0f64;
-    let mut worst: Option<(f64, String)> = None;
-    let mut cases = 0;
-    for t in tests {
-        let n = t.samples.len() as f64;
-        cases += t.samples.len() as u64;
-        let mean = t.samples.iter().sum::<f64>() / n;
-        let var = t.samples.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        let se = (var / n).sqrt();
-        let z = (mean - t.truth) / se;
-        max_error = max_error.max((mean - t.truth).abs());
-        figures.push(Figure {
-            name: t.name.clone(),
-            value: format!(
-                "mean {} ± {} (s.e.), exact {}, z = {}",
-                fmt_f64(mean),
-                fmt_f64(se),
-                fmt_f64(t.truth),
-                fmt_f64(z)
-            ),
-        });
-        let rejected = z.is_nan() || z.abs() > z_crit;
-        if rejected && worst.as_ref().is_none_or(|(a, _)| z.abs() > *a) {
-            worst = Some((
-                z.abs(),
-                format!(
-                    "{}: mean {} vs exact {} (z = {})",
-                    t.name,
-                    fmt_f64(mean),
-                    fmt_f64(t.truth),
-                    fmt_f64(z)
-                ),
-            ));
-        }
-    }
-    let outcome = match worst {
-        Some((z, counterexample)) => Outcome::Violated {
-            counterexample,
-            amount: z - z_crit,
-        },
-        None => Outcome::Holds { max_error },
-    };
-    Evaluation {
-        outcome,
-        cases,
-        figures,
-    }
-}
+/// Family-wise false-alarm rate of every statistical check in this module (Bonferroni across the family).
+pub(crate) const FAMILY_ALPHA: f64 = 1e-3;
 
 /// Trajectories per batch of the sampled checks (the experiments' N).
 pub(crate) const N: usize = 100;
@@ -302,7 +105,7 @@ fn assumption_4_6(ctx: &CheckContext<'_>) -> Evaluation {
             }
         }
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// Batch sizes of the Gaussian coverage check: small, where a wrong width is far from exact.
@@ -583,7 +386,10 @@ fn hp_tests(
 }
 
 fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirement) -> Evaluation {
-    let mut eval = frequency_outcome(&hp_tests(ctx, theorems, form, req, ctx.cases, 1.0));
+    let mut eval = frequency_outcome(
+        &hp_tests(ctx, theorems, form, req, ctx.cases, 1.0),
+        FAMILY_ALPHA,
+    );
     if !matches!(eval.outcome, Outcome::HoldsWithMargin { .. }) {
         return eval;
     }
@@ -591,7 +397,10 @@ fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirem
     let batches = ctx.cases.min(POWER_BATCHES);
     let mut detected_at = None;
     for scale in POWER_SCALES {
-        let control = frequency_outcome(&hp_tests(ctx, theorems, form, req, batches, scale));
+        let control = frequency_outcome(
+            &hp_tests(ctx, theorems, form, req, batches, scale),
+            FAMILY_ALPHA,
+        );
         if matches!(control.outcome, Outcome::Violated { .. }) {
             detected_at = Some(scale);
             eval.figures.extend(control.figures);
@@ -675,7 +484,7 @@ fn thm_3_12(ctx: &CheckContext<'_>) -> Evaluation {
             allowed: delta,
         });
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// Chebyshev batch sizes (Corollary 3.13): the batch size for ε, δ and the violation count of
@@ -690,7 +499,7 @@ enum Chebyshev {
 fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
     let (gamma, sigma, v, delta) = (0.5, 1.0, -0.3, 0.2);
     let Some(s) = Setting::new(Preset::Lqg, gamma, sigma, v, true) else {
-        return frequency_outcome(&[]);
+        return frequency_outcome(&[], FAMILY_ALPHA);
     };
     let k = *s.k();
     let (eps, kind) = match which {
@@ -711,7 +520,7 @@ fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
         }
     };
     let Ok(n) = n else {
-        return frequency_outcome(&[]);
+        return frequency_outcome(&[], FAMILY_ALPHA);
     };
     let spec = GradientSpec {
         kind,
@@ -733,12 +542,15 @@ fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
             violations += 1;
         }
     }
-    let mut eval = frequency_outcome(&[Freq {
-        name: format!("{which:?}: N = {n} (batches of max(N, 2)), ε = {eps}, δ = {delta}"),
-        violations,
-        trials,
-        allowed: delta,
-    }]);
+    let mut eval = frequency_outcome(
+        &[Freq {
+            name: format!("{which:?}: N = {n} (batches of max(N, 2)), ε = {eps}, δ = {delta}"),
+            violations,
+            trials,
+            allowed: delta,
+        }],
+        FAMILY_ALPHA,
+    );
     eval.figures.push(Figure {
         name: "batch size N from the formula".into(),
         value: n.to_string(),
@@ -858,7 +670,7 @@ fn unbiased(ctx: &CheckContext<'_>) -> Evaluation {
             }
         }
     }
-    z_outcome(&tests)
+    z_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// h(θ) = ∂_σ∇_vJ + (2/σ)∇_vJ from the oracle (Appendix B).
@@ -895,7 +707,7 @@ fn thm_b_1(ctx: &CheckContext<'_>) -> Evaluation {
             truth: exact_h(&s),
         });
     }
-    z_outcome(&tests)
+    z_outcome(&tests, FAMILY_ALPHA)
 }
 
 fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
@@ -929,7 +741,7 @@ fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
             truth: exact_h(&s),
         });
     }
-    let mut eval = z_outcome(&tests);
+    let mut eval = z_outcome(&tests, FAMILY_ALPHA);
     eval.figures.push(Figure {
         name: "per-trajectory variance with the B.2 baseline / without".into(),
         value: ratios,
@@ -1264,7 +1076,10 @@ mod tests {
     }
 
     fn rejected(tests: &[Freq]) -> bool {
-        matches!(frequency_outcome(tests).outcome, Outcome::Violated { .. })
+        matches!(
+            frequency_outcome(tests, FAMILY_ALPHA).outcome,
+            Outcome::Violated { .. }
+        )
     }
 
     #[test]
