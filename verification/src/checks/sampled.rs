@@ -801,10 +801,102 @@ const Z_FAR: &str = "1e-3 family-wise: two-sided z-test of the mean of independe
 estimates (N = 100 each), Bonferroni across components";
 
 /// The checks of this module, in registry order.
-pub(crate) fn checks() -> Vec<Check> {
-    let hp_sampling = "fixed settings lqg (σ = 1, v = −0.1) and lqg1d (σ = 0.5, v = −0.3), \
+/// Settings of the Appendix B checks (Theorem B.1 and the baseline B.2).
+const B_SAMPLING: &str = "lqg (σ = 0.5, v = −0.3) clipped and unclipped, lqg1d (σ = 1, v = −0.6) \
+        clipped, γ = 0.9; independent batches of N = 100 (one per case)";
+
+const HP_SAMPLING: &str = "fixed settings lqg (σ = 1, v = −0.1) and lqg1d (σ = 0.5, v = −0.3), \
         γ = 0.9, N = 100 trajectories per batch, G(PO)MDP with the leave-one-out optimal \
         baseline, t-widths at δ = 0.2; independent batches (one per case)";
+const CHEB_SAMPLING: &str = "lqg (clipped), γ = 0.5, σ = 1, v = −0.3, H = 20, δ = 0.2, no \
+        baseline; independent batches (one per case) of the formula's size N (at least 2)";
+
+pub(crate) fn checks() -> Vec<Check> {
+    vec![
+        thm_3_12_check(),
+        cor_3_13_gpomdp_check(),
+        cor_3_13_reinforce_check(),
+        cor_3_13_reinforce_printed_check(),
+        assumption_4_6_check(),
+        assumption_4_6_gaussian_check(),
+        thm_4_7_check(),
+        thm_4_8_check(),
+        thm_4_9_check(),
+        negative_c_printed_check(),
+        negative_c_sign_aware_check(),
+        summation_check(),
+        unbiased_check(),
+        thm_b_1_check(),
+        baseline_b_2_check(),
+    ]
+}
+
+/// The check `thm-3.12-hp-adaptive-step`.
+fn thm_3_12_check() -> Check {
+    let mut t312 = meta(
+        "thm-3.12-hp-adaptive-step",
+        "Theorem 3.12 (high-probability adaptive step, vertex form)",
+        "Section 3.4.1",
+        "With per-component t-widths, the step α* maximising the printed bound (vertex, \
+         sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
+         probability ≤ 1 − (1 − δ)^m (m = 1).",
+        DP_TRUTH,
+    );
+    t312.sampling = HP_SAMPLING.into();
+    t312.basis = BASIS_HP.into();
+    t312.notes = "Holds (the printed α*, with ‖∇⁻‖₁² in the denominator, is not the vertex: see \
+        ERRATA.md)."
+        .into();
+    Check::new(t312, thm_3_12)
+}
+
+/// The check `cor-3.13-gpomdp-batch-size`.
+fn cor_3_13_gpomdp_check() -> Check {
+    let mut c313g = meta(
+        "cor-3.13-gpomdp-batch-size",
+        "Corollary 3.13, G(PO)MDP/PGT batch size",
+        "Section 3.4.1",
+        "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313g.sampling = CHEB_SAMPLING.into();
+    c313g.notes = "Holds with a large margin (Chebyshev is loose).".into();
+    Check::new(c313g, cor_3_13_gpomdp)
+}
+
+/// The check `cor-3.13-reinforce-batch-size`.
+fn cor_3_13_reinforce_check() -> Check {
+    let mut c313r = meta(
+        "cor-3.13-reinforce-batch-size",
+        "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
+        "Section 3.4.1; Pirotta et al. 2013, Theorem 5.4",
+        "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313r.sampling = CHEB_SAMPLING.into();
+    c313r.notes = "Holds.".into();
+    Check::new(c313r, cor_3_13_reinforce)
+}
+
+/// The check `cor-3.13-reinforce-printed`.
+fn cor_3_13_reinforce_printed_check() -> Check {
+    let mut c313p = meta(
+        "cor-3.13-reinforce-printed",
+        "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
+        "Section 3.4.1",
+        "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313p.sampling = CHEB_SAMPLING.into();
+    c313p.expected = Expected::Violated;
+    c313p.notes = "Violated: the printed count vanishes as H grows (N = 1 here; batches of 2 are \
+        used) and the error exceeds ε far more often than δ. See ERRATA.md."
+        .into();
+    Check::new(c313p, cor_3_13_reinforce_printed)
+}
+
+/// The check `assumption-4.6-t-coverage`.
+fn assumption_4_6_check() -> Check {
     let mut a46 = meta(
         "assumption-4.6-t-coverage",
         "Assumption 4.6 with the t-based widths of Section 4.5",
@@ -831,6 +923,11 @@ pub(crate) fn checks() -> Vec<Check> {
         not give its size. The width itself is checked against theory by \
         assumption-4.6-t-coverage-gaussian"
         .into();
+    Check::new(a46, assumption_4_6)
+}
+
+/// The check `assumption-4.6-t-coverage-gaussian`.
+fn assumption_4_6_gaussian_check() -> Check {
     let mut a46g = meta(
         "assumption-4.6-t-coverage-gaussian",
         "Assumption 4.6 with the t-based widths of Section 4.5, on Gaussian samples",
@@ -853,6 +950,11 @@ pub(crate) fn checks() -> Vec<Check> {
         N − 1: miss rate ≈ 0.10 instead of 0.05 at N = 3) or the wrong level fails."
         .into();
     a46g.basis = "theory: Student's theorem (exact coverage 1 − δ for Gaussian samples)".into();
+    Check::new(a46g, assumption_4_6_gaussian)
+}
+
+/// The check `thm-4.7-hp-v-update`.
+fn thm_4_7_check() -> Check {
     let mut t47 = meta(
         "thm-4.7-hp-v-update",
         "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, docs/CONVENTIONS.md §4 vertex)",
@@ -861,9 +963,14 @@ pub(crate) fn checks() -> Vec<Check> {
          step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)^m (m = 1).",
         DP_TRUTH,
     );
-    t47.sampling = hp_sampling.into();
+    t47.sampling = HP_SAMPLING.into();
     t47.basis = BASIS_HP.into();
     t47.notes = "Holds.".into();
+    Check::new(t47, thm_4_7)
+}
+
+/// The check `thm-4.8-hp-w-update`.
+fn thm_4_8_check() -> Check {
     let mut t48 = meta(
         "thm-4.8-hp-w-update",
         "Theorem 4.8, eqs. (4.27)–(4.29)",
@@ -872,9 +979,14 @@ pub(crate) fn checks() -> Vec<Check> {
          J(θ′) − J(θ) ≥ C except with probability ≤ δ.",
         DP_TRUTH,
     );
-    t48.sampling = hp_sampling.into();
+    t48.sampling = HP_SAMPLING.into();
     t48.basis = BASIS_HP.into();
     t48.notes = "Holds.".into();
+    Check::new(t48, thm_4_8)
+}
+
+/// The check `thm-4.9-hp-w-along-l`.
+fn thm_4_9_check() -> Check {
     let mut t49 = meta(
         "thm-4.9-hp-w-along-l",
         "Theorem 4.9, eq. (4.30)",
@@ -883,9 +995,14 @@ pub(crate) fn checks() -> Vec<Check> {
          largest step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)².",
         DP_TRUTH,
     );
-    t49.sampling = hp_sampling.into();
+    t49.sampling = HP_SAMPLING.into();
     t49.basis = BASIS_HP.into();
     t49.notes = "Holds.".into();
+    Check::new(t49, thm_4_9)
+}
+
+/// The check `thm-4.7-4.9-negative-c-printed`.
+fn negative_c_printed_check() -> Check {
     let mut neg_p = meta(
         "thm-4.7-4.9-negative-c-printed",
         "Theorems 4.7–4.9 for C < 0, intervals (4.26), (4.29), (4.30) as printed",
@@ -895,13 +1012,18 @@ pub(crate) fn checks() -> Vec<Check> {
          ≤ 1 − (1 − δ)^m.",
         DP_TRUTH,
     );
-    neg_p.sampling = hp_sampling.into();
+    neg_p.sampling = HP_SAMPLING.into();
     neg_p.expected = Expected::Violated;
     neg_p.notes = "Violated: on the side opposite to the estimate the valid linear term is \
         −|x|(‖∇̂‖⁺)², not the printed −|x|(‖∇̂‖⁻)², so the printed end point realises less than C \
         whenever the true gradient is larger than the lower-corrected estimate (most batches). \
         See ERRATA.md; sepg uses the sign-aware interval (thm-4.7-4.9-negative-c-sign-aware)."
         .into();
+    Check::new(neg_p, negative_c_printed)
+}
+
+/// The check `thm-4.7-4.9-negative-c-sign-aware`.
+fn negative_c_sign_aware_check() -> Check {
     let mut neg_s = meta(
         "thm-4.7-4.9-negative-c-sign-aware",
         "Theorems 4.7–4.9 for C < 0 with the sign-aware interval (docs/CONVENTIONS.md §4)",
@@ -909,55 +1031,14 @@ pub(crate) fn checks() -> Vec<Check> {
         "Same as thm-4.7-4.9-negative-c-printed with the sign-aware interval.",
         DP_TRUTH,
     );
-    neg_s.sampling = hp_sampling.into();
+    neg_s.sampling = HP_SAMPLING.into();
     neg_s.basis = BASIS_HP.into();
     neg_s.notes = "Holds.".into();
-    let mut t312 = meta(
-        "thm-3.12-hp-adaptive-step",
-        "Theorem 3.12 (high-probability adaptive step, vertex form)",
-        "Section 3.4.1",
-        "With per-component t-widths, the step α* maximising the printed bound (vertex, \
-         sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
-         probability ≤ 1 − (1 − δ)^m (m = 1).",
-        DP_TRUTH,
-    );
-    t312.sampling = hp_sampling.into();
-    t312.basis = BASIS_HP.into();
-    t312.notes = "Holds (the printed α*, with ‖∇⁻‖₁² in the denominator, is not the vertex: see \
-        ERRATA.md)."
-        .into();
-    let cheb_sampling = "lqg (clipped), γ = 0.5, σ = 1, v = −0.3, H = 20, δ = 0.2, no \
-        baseline; independent batches (one per case) of the formula's size N (at least 2)";
-    let mut c313g = meta(
-        "cor-3.13-gpomdp-batch-size",
-        "Corollary 3.13, G(PO)MDP/PGT batch size",
-        "Section 3.4.1",
-        "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313g.sampling = cheb_sampling.into();
-    c313g.notes = "Holds with a large margin (Chebyshev is loose).".into();
-    let mut c313r = meta(
-        "cor-3.13-reinforce-batch-size",
-        "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
-        "Section 3.4.1; Pirotta et al. 2013, Theorem 5.4",
-        "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313r.sampling = cheb_sampling.into();
-    c313r.notes = "Holds.".into();
-    let mut c313p = meta(
-        "cor-3.13-reinforce-printed",
-        "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
-        "Section 3.4.1",
-        "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313p.sampling = cheb_sampling.into();
-    c313p.expected = Expected::Violated;
-    c313p.notes = "Violated: the printed count vanishes as H grows (N = 1 here; batches of 2 are \
-        used) and the error exceeds ε far more often than δ. See ERRATA.md."
-        .into();
+    Check::new(neg_s, negative_c_sign_aware)
+}
+
+/// The check `summation-theorem-pgt-gpomdp`.
+fn summation_check() -> Check {
     let mut sum = meta(
         "summation-theorem-pgt-gpomdp",
         "Summation theorem: PGT = G(PO)MDP (Section 2.3.1, used in Section 3.4.1)",
@@ -979,6 +1060,11 @@ pub(crate) fn checks() -> Vec<Check> {
     sum.cases_quick = 100;
     sum.false_alarm_rate = "0: deterministic; rounding of 20-term sums is ≈ 1e-15 relative".into();
     sum.notes = "Holds.".into();
+    Check::new(sum, summation)
+}
+
+/// The check `reinforce-gpomdp-unbiased`.
+fn unbiased_check() -> Check {
     let mut unb = meta(
         "reinforce-gpomdp-unbiased",
         "REINFORCE (2.1), G(PO)MDP and PGT with baselines are unbiased",
@@ -993,6 +1079,11 @@ pub(crate) fn checks() -> Vec<Check> {
         .into();
     unb.false_alarm_rate = Z_FAR.into();
     unb.notes = "Holds.".into();
+    Check::new(unb, unbiased)
+}
+
+/// The check `thm-b.1-h-unbiased`.
+fn thm_b_1_check() -> Check {
     let mut b1 = meta(
         "thm-b.1-h-unbiased",
         "Theorem B.1: ĥ of (B.3) is unbiased for h(θ)",
@@ -1001,11 +1092,14 @@ pub(crate) fn checks() -> Vec<Check> {
         "exact ∇_vJ and ∂_σ∇_vJ: DP oracle (clipped) and closed form (unclipped)",
     );
     b1.kind = ClaimKind::Equality;
-    b1.sampling = "lqg (σ = 0.5, v = −0.3) clipped and unclipped, lqg1d (σ = 1, v = −0.6) \
-        clipped, γ = 0.9; independent batches of N = 100 (one per case)"
-        .into();
+    b1.sampling = B_SAMPLING.into();
     b1.false_alarm_rate = Z_FAR.into();
     b1.notes = "Holds.".into();
+    Check::new(b1, thm_b_1)
+}
+
+/// The check `app-b.2-baseline`.
+fn baseline_b_2_check() -> Check {
     let mut b2 = meta(
         "app-b.2-baseline",
         "Appendix B.2: the baseline b_t = b̃_t(G_t + H_t)/(G_tH_t) keeps ĥ unbiased and reduces \
@@ -1016,26 +1110,10 @@ pub(crate) fn checks() -> Vec<Check> {
         "exact h(θ) as in thm-b.1-h-unbiased; pooled sample variances",
     );
     b2.kind = ClaimKind::Equality;
-    b2.sampling = b1.sampling.clone();
+    b2.sampling = B_SAMPLING.into();
     b2.false_alarm_rate = Z_FAR.into();
     b2.notes = "Holds.".into();
-    vec![
-        Check::new(t312, thm_3_12),
-        Check::new(c313g, cor_3_13_gpomdp),
-        Check::new(c313r, cor_3_13_reinforce),
-        Check::new(c313p, cor_3_13_reinforce_printed),
-        Check::new(a46, assumption_4_6),
-        Check::new(a46g, assumption_4_6_gaussian),
-        Check::new(t47, thm_4_7),
-        Check::new(t48, thm_4_8),
-        Check::new(t49, thm_4_9),
-        Check::new(neg_p, negative_c_printed),
-        Check::new(neg_s, negative_c_sign_aware),
-        Check::new(sum, summation),
-        Check::new(unb, unbiased),
-        Check::new(b1, thm_b_1),
-        Check::new(b2, baseline_b_2),
-    ]
+    Check::new(b2, baseline_b_2)
 }
 
 #[cfg(test)]
