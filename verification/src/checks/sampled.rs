@@ -125,23 +125,7 @@ fn assumption_4_6_gaussian(ctx: &CheckContext<'_>) -> Evaluation {
     let mut trials_total = 0;
     let mut x = Vec::new();
     for &n in &GAUSSIAN_NS {
-        let mut misses = [0u64; 2];
-        let mut trials = 0u64;
-        for _ in 0..ctx.cases {
-            x.clear();
-            x.extend((0..n).map(|_| 0.5 + 2.0 * sepg_mdp::rng::standard_normal(&mut rng)));
-            let mean = x.iter().sum::<f64>() / n as f64;
-            let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n as f64 - 1.0);
-            trials += 1;
-            for (di, &delta) in deltas.iter().enumerate() {
-                let Ok(eps) = sepg_estimators::width(Width::StudentT, var, n, delta) else {
-                    continue;
-                };
-                if (mean - 0.5).abs() > eps {
-                    misses[di] += 1;
-                }
-            }
-        }
+        let (misses, trials) = gaussian_misses(&mut rng, &mut x, n, ctx.cases, &deltas);
         trials_total += trials;
         for (di, &delta) in deltas.iter().enumerate() {
             let (Ok(lo), Ok(hi)) = (
@@ -196,6 +180,36 @@ fn assumption_4_6_gaussian(ctx: &CheckContext<'_>) -> Evaluation {
         cases: trials_total,
         figures,
     }
+}
+
+/// Draws `cases` batches of `n` independent N(0.5, 2²) samples and counts, for each δ of
+/// `deltas`, the batches whose Student-t interval at level δ misses the mean 0.5; returns the
+/// miss counts and the number of batches.
+fn gaussian_misses(
+    rng: &mut sepg_mdp::rng::TrajRng,
+    x: &mut Vec<f64>,
+    n: usize,
+    cases: u32,
+    deltas: &[f64; 2],
+) -> ([u64; 2], u64) {
+    let mut misses = [0u64; 2];
+    let mut trials = 0u64;
+    for _ in 0..cases {
+        x.clear();
+        x.extend((0..n).map(|_| 0.5 + 2.0 * sepg_mdp::rng::standard_normal(rng)));
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n as f64 - 1.0);
+        trials += 1;
+        for (di, &delta) in deltas.iter().enumerate() {
+            let Ok(eps) = sepg_estimators::width(Width::StudentT, var, n, delta) else {
+                continue;
+            };
+            if (mean - 0.5).abs() > eps {
+                misses[di] += 1;
+            }
+        }
+    }
+    (misses, trials)
 }
 
 /// Which high-probability theorem.
@@ -254,41 +268,14 @@ fn hp_counts(
         ) else {
             continue;
         };
-        let (bound, direction) = match which {
-            Hp::V => (
-                HighProbabilityBound::v_update(s.k(), s.sigma, gv.mean(), cv.eps),
-                gv.mean()[0],
-            ),
-            Hp::WJ => (
-                HighProbabilityBound::w_along_j(s.k(), s.sigma, gw.mean()[0], cw.eps),
-                gw.mean()[0],
-            ),
-            Hp::WL => {
-                let mut sur = SurrogateEstimate::new();
-                if est
-                    .surrogate_gradient_for_task(&batch, GradientSpec::default(), s.k(), &mut sur)
-                    .is_err()
-                {
-                    continue;
-                }
-                let Ok(cl) = sur.grad_w_l().confidence(Width::StudentT, delta) else {
-                    continue;
-                };
-                let gl = sur.grad_w_l().mean()[0];
-                (
-                    HighProbabilityBound::w_along_l(
-                        s.k(),
-                        s.sigma,
-                        gw.mean()[0],
-                        cw.eps,
-                        gl,
-                        cl.eps,
-                    ),
-                    gl,
-                )
-            }
-        };
-        let Ok(Some(bound)) = bound else {
+        let Some((bound, direction)) = hp_bound(
+            s,
+            which,
+            &mut est,
+            &batch,
+            (&gv, &gw),
+            (cv.eps, cw.eps, delta),
+        ) else {
             continue;
         };
         let c_max = bound.c_max();
@@ -324,6 +311,50 @@ fn hp_counts(
         }
     }
     counts
+}
+
+/// The high-probability bound of theorem `which` on one batch, from the batch's gradient
+/// estimates `(∇̂_v J, ∇̂_w J)` and `(ε_v, ε_wJ, δ)`, with the estimated direction of its step;
+/// `None` when an estimate or the bound is unavailable.
+fn hp_bound(
+    s: &Setting,
+    which: Hp,
+    est: &mut Estimator,
+    batch: &Batch,
+    (gv, gw): (&Estimate, &Estimate),
+    (eps_v, eps_w, delta): (f64, f64, f64),
+) -> Option<(HighProbabilityBound, f64)> {
+    let (bound, direction) = match which {
+        Hp::V => (
+            HighProbabilityBound::v_update(s.k(), s.sigma, gv.mean(), eps_v),
+            gv.mean()[0],
+        ),
+        Hp::WJ => (
+            HighProbabilityBound::w_along_j(s.k(), s.sigma, gw.mean()[0], eps_w),
+            gw.mean()[0],
+        ),
+        Hp::WL => {
+            let mut sur = SurrogateEstimate::new();
+            if est
+                .surrogate_gradient_for_task(&batch, GradientSpec::default(), s.k(), &mut sur)
+                .is_err()
+            {
+                return None;
+            }
+            let Ok(cl) = sur.grad_w_l().confidence(Width::StudentT, delta) else {
+                return None;
+            };
+            let gl = sur.grad_w_l().mean()[0];
+            (
+                HighProbabilityBound::w_along_l(s.k(), s.sigma, gw.mean()[0], eps_w, gl, cl.eps),
+                gl,
+            )
+        }
+    };
+    let Ok(Some(bound)) = bound else {
+        return None;
+    };
+    Some((bound, direction))
 }
 
 pub(crate) fn hp_settings() -> [(Preset, f64, f64); 2] {
