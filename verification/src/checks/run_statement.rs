@@ -487,42 +487,7 @@ fn evaluate(results: &[CellResult], seeds: u64, iterations: u64) -> Evaluation {
             value: q.to_string(),
         },
     ];
-    let mut kinds: Vec<StatementKind> = Vec::new();
-    for r in results {
-        for k in &r.kinds {
-            if !kinds.contains(k) {
-                kinds.push(*k);
-            }
-        }
-        let first = r.first.as_ref().map_or(String::new(), |(seed, b)| {
-            format!(
-                "; first: seed {seed}, iteration {}, {} short by {}",
-                b.iteration,
-                b.what,
-                fmt_f64(b.shortfall)
-            )
-        });
-        figures.push(Figure {
-            name: format!("{}: broken runs", r.label),
-            value: format!(
-                "{} of {} (tightest slack {}){first}",
-                r.broken,
-                r.runs,
-                fmt_f64(r.tightest)
-            ),
-        });
-    }
-    figures.insert(
-        0,
-        Figure {
-            name: "statement kinds of the runs".into(),
-            value: kinds
-                .iter()
-                .map(|k| kind_name(*k))
-                .collect::<Vec<_>>()
-                .join(", "),
-        },
-    );
+    cell_figures(results, &mut figures);
     let runs: u64 = results.iter().map(|r| r.runs).sum();
     let evals = results.iter().fold((0, 0), |a, r| {
         (a.0 + r.evaluations.0, a.1 + r.evaluations.1)
@@ -564,6 +529,47 @@ fn evaluate(results: &[CellResult], seeds: u64, iterations: u64) -> Evaluation {
         cases: runs,
         figures,
     }
+}
+
+/// Appends the figures of each cell (broken runs, tightest slack, first failure) and puts
+/// first a figure listing the statement kinds the runs recorded.
+fn cell_figures(results: &[CellResult], figures: &mut Vec<Figure>) {
+    let mut kinds: Vec<StatementKind> = Vec::new();
+    for r in results {
+        for k in &r.kinds {
+            if !kinds.contains(k) {
+                kinds.push(*k);
+            }
+        }
+        let first = r.first.as_ref().map_or(String::new(), |(seed, b)| {
+            format!(
+                "; first: seed {seed}, iteration {}, {} short by {}",
+                b.iteration,
+                b.what,
+                fmt_f64(b.shortfall)
+            )
+        });
+        figures.push(Figure {
+            name: format!("{}: broken runs", r.label),
+            value: format!(
+                "{} of {} (tightest slack {}){first}",
+                r.broken,
+                r.runs,
+                fmt_f64(r.tightest)
+            ),
+        });
+    }
+    figures.insert(
+        0,
+        Figure {
+            name: "statement kinds of the runs".into(),
+            value: kinds
+                .iter()
+                .map(|k| kind_name(*k))
+                .collect::<Vec<_>>()
+                .join(", "),
+        },
+    );
 }
 
 fn cells(presets: &[Preset], variants: &[Requirement], optimum_only: bool) -> Vec<Cell> {
