@@ -104,36 +104,6 @@ impl Task {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use approx::assert_relative_eq;
-    use sepg_bounds::constants::c;
-
-    #[test]
-    fn presets_publish_the_constants_of_their_boxes_in_order() {
-        // From the boxes and rewards (docs/CONVENTIONS.md §1): lqg has S = A = [−2, 2] and
-        // reward −0.5(s² + a²), so R = 0.5(4 + 4) = 4, M_φ = 2, |A| = 4; lqg1d has
-        // S = A = [−4, 4] and −0.9(s² + a²), so R = 0.9(16 + 16) = 28.8, M_φ = 4, |A| = 8.
-        for (preset, r, m, a) in [
-            (Preset::Lqg, 4.0, 2.0, 4.0),
-            (Preset::Lqg1d, 28.8, 4.0, 8.0),
-        ] {
-            let task = Task::new(preset, 0.9).expect("preset builds");
-            let k = &task.k;
-            assert_eq!(k.gamma(), 0.9);
-            assert_relative_eq!(k.r_max(), r, max_relative = 1e-15);
-            assert_eq!((k.m_phi(), k.action_volume()), (m, a), "{preset:?}");
-            // c(σ) of Theorem 4.2 from its printed formula with these constants.
-            let sigma: f64 = 0.7;
-            let printed = r * m * m / (0.1 * 0.1)
-                * (a / ((2.0 * std::f64::consts::PI).sqrt() * sigma.powi(3))
-                    + 0.9 / (2.0 * 0.1 * sigma * sigma));
-            assert_relative_eq!(c(k, sigma).unwrap(), printed, max_relative = 1e-12);
-        }
-    }
-}
-
 /// A policy on a preset, with its exact values, rollouts and estimators.
 pub(crate) struct Setting {
     pub(crate) task: Task,
@@ -185,5 +155,35 @@ impl Setting {
 
     pub(crate) fn k(&self) -> &TaskConstants {
         &self.task.k
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use sepg_bounds::constants::c;
+
+    #[test]
+    fn presets_publish_the_constants_of_their_boxes_in_order() {
+        // From the boxes and rewards (docs/CONVENTIONS.md §1): lqg has S = A = [−2, 2] and
+        // reward −0.5(s² + a²), so R = 0.5(4 + 4) = 4, M_φ = 2, |A| = 4; lqg1d has
+        // S = A = [−4, 4] and −0.9(s² + a²), so R = 0.9(16 + 16) = 28.8, M_φ = 4, |A| = 8.
+        for (preset, r, m, a) in [
+            (Preset::Lqg, 4.0, 2.0, 4.0),
+            (Preset::Lqg1d, 28.8, 4.0, 8.0),
+        ] {
+            let task = Task::new(preset, 0.9).expect("preset builds");
+            let k = &task.k;
+            assert_eq!(k.gamma(), 0.9);
+            assert_relative_eq!(k.r_max(), r, max_relative = 1e-15);
+            assert_eq!((k.m_phi(), k.action_volume()), (m, a), "{preset:?}");
+            // c(σ) of Theorem 4.2 from its printed formula with these constants.
+            let sigma: f64 = 0.7;
+            let printed = r * m * m / (0.1 * 0.1)
+                * (a / ((2.0 * std::f64::consts::PI).sqrt() * sigma.powi(3))
+                    + 0.9 / (2.0 * 0.1 * sigma * sigma));
+            assert_relative_eq!(c(k, sigma).unwrap(), printed, max_relative = 1e-12);
+        }
     }
 }

@@ -972,7 +972,7 @@ fn tally_step(
         step,
         required,
     } = *a;
-    tally_applied(t, form, index, c, &k, step, required, ex);
+    tally_applied(t, form, index, c, k, step, required, ex);
     t.certified_steps += 1;
     t.tight_certified_steps += u64::from(matches!(c.family, Family::Tight(_)));
     if st.by_error_bound {
@@ -990,10 +990,10 @@ fn tally_step(
             ));
         }
     }
-    if b.certainly_lt(&cc) {
+    if b.certainly_lt(cc) {
         t.certified_violations += 1;
         return Some("certified step violates C");
-    } else if !b.certainly_ge(&cc) {
+    } else if !b.certainly_ge(cc) {
         t.undecided += 1;
         return Some("undecided at 256 bits");
     }

@@ -336,7 +336,7 @@ fn hp_bound(
         Hp::WL => {
             let mut sur = SurrogateEstimate::new();
             if est
-                .surrogate_gradient_for_task(&batch, GradientSpec::default(), s.k(), &mut sur)
+                .surrogate_gradient_for_task(batch, GradientSpec::default(), s.k(), &mut sur)
                 .is_err()
             {
                 return None;
