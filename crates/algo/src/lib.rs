@@ -9,5 +9,8 @@
 //! - [`solver`] holds the algorithms: SEPG with every safety requirement of Table 4.1, SEPG with
 //!   the naive variance update (4.12), G(PO)MDP with constant step or Adam, and the adaptive
 //!   step of Pirotta et al. (Corollary 3.11, Theorem 3.12).
+
+#![deny(missing_docs)]
+
 pub mod core;
 pub mod solver;

@@ -21,6 +21,8 @@
 //! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
 //! [`Error`]; nothing here prints.
 
+#![deny(missing_docs)]
+
 pub mod audit;
 pub mod error;
 pub mod estimate;
