@@ -17,6 +17,8 @@
 //!
 //! The `sepg` binary built from this package is the command-line interface.
 
+#![deny(missing_docs)]
+
 pub use sepg_algo as algo;
 pub use sepg_bounds as bounds;
 pub use sepg_certified as certified;

@@ -105,7 +105,7 @@ pub fn json_ok(out: &Output) -> serde_json::Value {
 /// Relative closeness, `rel` in units of the larger magnitude, with an absolute floor of
 /// `rel`·1e-300 (so that two zeros are close).
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
-    approx::relative_eq!(a, b, epsilon = rel * 1e-300, max_relative = rel)
+    sepg_testkit::close(a, b, rel, 1e-300)
 }
 
 /// The number under `key` of a JSON object, panicking with the object if it is missing.

@@ -17,6 +17,8 @@
 //! assert!(report.to_markdown().contains("thm-3.3-performance-difference"));
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod bound_fns;
 pub mod campaign;
 mod check;

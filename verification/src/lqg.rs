@@ -8,11 +8,15 @@
 //! same stationary Gaussian policy, so every bound applies to J_H verbatim.
 
 use sepg_bounds::constants::TaskConstants;
+use sepg_mdp::Batch;
 use sepg_mdp::env::LqgEnv;
 use sepg_mdp::lqg_model::LqgModel;
 use sepg_mdp::oracle::{
     ClippedDpOracle, ClosedFormOracle, ExactEval, ExactOracle, Exploration, Horizon,
 };
+use sepg_mdp::policy::GaussianPolicy;
+use sepg_mdp::rng::SeedKey;
+use sepg_mdp::rollout::rollout;
 
 /// Horizon of every finite-horizon J in the harness (the experiments' H).
 pub(crate) const HORIZON: usize = 20;
@@ -97,6 +101,60 @@ impl Task {
             .ok()?
             .with_horizon(HORIZON)
             .ok()
+    }
+}
+
+/// A policy on a preset, with its exact values, rollouts and estimators.
+pub(crate) struct Setting {
+    pub(crate) task: Task,
+    env: LqgEnv,
+    policy: GaussianPolicy,
+    pub(crate) v: f64,
+    pub(crate) w: f64,
+    pub(crate) sigma: f64,
+    pub(crate) exact: ExactEval,
+}
+
+impl Setting {
+    pub(crate) fn new(
+        preset: Preset,
+        gamma: f64,
+        sigma: f64,
+        v: f64,
+        clipped: bool,
+    ) -> Option<Self> {
+        let task = if clipped {
+            Task::new(preset, gamma)?
+        } else {
+            Task::unclipped(preset, gamma)?
+        };
+        let env = task.env()?;
+        let w = sigma.ln();
+        let exact = task.eval(v, w)?;
+        Some(Self {
+            policy: GaussianPolicy::scalar(v, w).ok()?,
+            task,
+            env,
+            v,
+            w,
+            sigma,
+            exact,
+        })
+    }
+
+    pub(crate) fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
+        rollout(
+            &self.env,
+            &self.policy,
+            n,
+            HORIZON,
+            SeedKey::new(seed, index, 0),
+        )
+        .ok()
+    }
+
+    pub(crate) fn k(&self) -> &TaskConstants {
+        &self.task.k
     }
 }
 

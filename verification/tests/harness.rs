@@ -6,6 +6,7 @@ use approx::{assert_abs_diff_eq, relative_eq};
 use sepg_bounds::BoundsError;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::outcome::{SafeInterval, StepOutcome};
+use sepg_testkit::pool;
 use sepg_verification::finite_mdp::{FiniteMdp, MdpError, TabularPolicy};
 use sepg_verification::stats::{StatsError, clopper_pearson_lower, clopper_pearson_upper};
 use sepg_verification::{BoundFns, Outcome, RunConfig, derive_seed, registry, run_checks};
@@ -13,13 +14,6 @@ use sepg_verification::{BoundFns, Outcome, RunConfig, derive_seed, registry, run
 /// Pinned outputs of `derive_seed` (value-stability).
 const PINNED_0: u64 = 0x593d_771d_1f41_4334;
 const PINNED_42: u64 = 0xd61f_c146_e22e_15d4;
-
-fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool")
-}
 
 /// One check of each kind (finite MDPs, closed forms, DP oracle, sampled, algorithm), so that
 /// the determinism tests stay fast.

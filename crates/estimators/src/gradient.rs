@@ -472,39 +472,8 @@ impl Estimator {
         match target {
             Target::Gpomdp(p) | Target::Pgt(p) => {
                 let (s, comps) = scores(p);
-                let w = h * comps;
-                let s = Rows::new(s, w);
-                let f = broadcast(&mut self.bcast, rewards, h, comps);
-                if let Target::Pgt(_) = target {
-                    run_score(
-                        &mut self.sums,
-                        s,
-                        f,
-                        nr,
-                        w,
-                        comps,
-                        baseline,
-                        fit,
-                        Output::Baselines,
-                    );
-                    let base = self.sums.baselines(w);
-                    let f = Rows::new(rewards, h);
-                    for (r, x) in out[..nr * comps].chunks_exact_mut(comps).enumerate() {
-                        pgt_sample(s.row(r, w), f.row(r, h), base.row(r, w), x);
-                    }
-                } else {
-                    run_score(
-                        &mut self.sums,
-                        s,
-                        f,
-                        nr,
-                        w,
-                        comps,
-                        baseline,
-                        fit,
-                        Output::Sums(out),
-                    );
-                }
+                let pgt = matches!(target, Target::Pgt(_));
+                self.score_target(s, comps, rewards, (h, nr), pgt, (baseline, fit), out);
             }
             Target::Reinforce(p) => {
                 let (s, comps) = scores(p);
@@ -524,23 +493,82 @@ impl Estimator {
                     Output::Sums(out),
                 );
             }
-            Target::H => {
-                self.fill_h(batch, rows, rewards, baseline);
-                let comps = batch.dim_w * batch.dim_v;
-                let w = h * comps;
-                let (u, z) = (Rows::new(&self.h_u, w), Rows::new(&self.h_z, w));
-                let out = Output::Sums(out);
-                if baseline == Baseline::Mean {
-                    let f = broadcast(&mut self.bcast, rewards, h, comps);
-                    self.sums
-                        .run::<3, HMean>([u, z, f], nr, w, comps, baseline, fit, out);
-                } else {
-                    self.sums
-                        .run::<2, HOptimal>([u, z], nr, w, comps, baseline, fit, out);
-                }
-            }
+            Target::H => self.h_target(batch, rows, rewards, (baseline, fit), out),
         }
         self.shifted = shifted;
+    }
+
+    /// G(PO)MDP or PGT (`pgt`) samples of one parameter: scores `s` with `comps` components per
+    /// step, the rows' discounted `rewards`, `(h, nr)` = (horizon, rows).
+    #[allow(clippy::too_many_arguments)]
+    fn score_target(
+        &mut self,
+        s: &[f64],
+        comps: usize,
+        rewards: &[f64],
+        (h, nr): (usize, usize),
+        pgt: bool,
+        (baseline, fit): (Baseline, BaselineFit),
+        out: &mut [f64],
+    ) {
+        let w = h * comps;
+        let s = Rows::new(s, w);
+        let f = broadcast(&mut self.bcast, rewards, h, comps);
+        if pgt {
+            run_score(
+                &mut self.sums,
+                s,
+                f,
+                nr,
+                w,
+                comps,
+                baseline,
+                fit,
+                Output::Baselines,
+            );
+            let base = self.sums.baselines(w);
+            let f = Rows::new(rewards, h);
+            for (r, x) in out[..nr * comps].chunks_exact_mut(comps).enumerate() {
+                pgt_sample(s.row(r, w), f.row(r, h), base.row(r, w), x);
+            }
+        } else {
+            run_score(
+                &mut self.sums,
+                s,
+                f,
+                nr,
+                w,
+                comps,
+                baseline,
+                fit,
+                Output::Sums(out),
+            );
+        }
+    }
+
+    /// The samples of ĥ (Theorem B.1) with the mean or the B.2 baseline.
+    fn h_target(
+        &mut self,
+        batch: &Batch,
+        rows: Range<usize>,
+        rewards: &[f64],
+        (baseline, fit): (Baseline, BaselineFit),
+        out: &mut [f64],
+    ) {
+        let (h, nr) = (batch.horizon, rows.len());
+        self.fill_h(batch, rows, rewards, baseline);
+        let comps = batch.dim_w * batch.dim_v;
+        let w = h * comps;
+        let (u, z) = (Rows::new(&self.h_u, w), Rows::new(&self.h_z, w));
+        let out = Output::Sums(out);
+        if baseline == Baseline::Mean {
+            let f = broadcast(&mut self.bcast, rewards, h, comps);
+            self.sums
+                .run::<3, HMean>([u, z, f], nr, w, comps, baseline, fit, out);
+        } else {
+            self.sums
+                .run::<2, HOptimal>([u, z], nr, w, comps, baseline, fit, out);
+        }
     }
 
     /// Fills `h_u` with `u = G_k H_j F` and `h_z` with the control variate of `baseline`

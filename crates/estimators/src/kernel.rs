@@ -169,109 +169,153 @@ impl Sums {
         fit: BaselineFit,
         output: Output<'_>,
     ) {
-        let w = width;
-        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
         let keep_base = matches!(output, Output::Baselines);
         // Row r + 1 of `suf_num` receives trajectory r's sample terms (or baselines).
-        let used = (rows + 1) * w;
-        grow(&mut self.suf_num, used);
+        grow(&mut self.suf_num, (rows + 1) * width);
         self.shared_base = false;
         match (baseline, fit) {
-            (Baseline::None, _) => {
-                if keep_base {
-                    self.suf_num[..w].fill(0.0);
-                    self.shared_base = true;
-                } else {
-                    for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
-                        let v = row(r);
-                        for (e, p) in p.iter_mut().enumerate() {
-                            *p = F::plain(std::array::from_fn(|k| v[k][e]));
-                        }
-                    }
-                }
-            }
-            (_, BaselineFit::PlugIn) => {
-                zeroed(&mut self.pre_num, w);
-                zeroed(&mut self.pre_den, w);
-                for r in 0..rows {
-                    let v = row(r);
-                    for (e, (pn, pd)) in self.pre_num.iter_mut().zip(&mut self.pre_den).enumerate()
-                    {
-                        let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
-                        *pn += n;
-                        *pd += d;
-                    }
-                }
-                for (b, d) in self.pre_num.iter_mut().zip(&self.pre_den) {
-                    *b = ratio(*b, *d);
-                }
-                if keep_base {
-                    self.suf_num[..w].copy_from_slice(&self.pre_num);
-                    self.shared_base = true;
-                } else {
-                    for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
-                        let v = row(r);
-                        for (e, (p, b)) in p.iter_mut().zip(&self.pre_num).enumerate() {
-                            *p = F::sample(std::array::from_fn(|k| v[k][e]), *b);
-                        }
-                    }
-                }
-            }
+            (Baseline::None, _) => self.no_baseline::<K, F>(inputs, rows, width, keep_base),
+            (_, BaselineFit::PlugIn) => self.plug_in::<K, F>(inputs, rows, width, keep_base),
             (_, BaselineFit::LeaveOneOut) => {
-                grow(&mut self.suf_den, used);
-                // Rows 0..rows are overwritten; row `rows` is the empty sum.
-                self.suf_num[rows * w..used].fill(0.0);
-                self.suf_den[rows * w..used].fill(0.0);
-                for r in (0..rows).rev() {
-                    let v = row(r);
-                    let (sn, sn_next) = self.suf_num[r * w..(r + 2) * w].split_at_mut(w);
-                    let (sd, sd_next) = self.suf_den[r * w..(r + 2) * w].split_at_mut(w);
-                    let next = sn_next.iter().zip(sd_next.iter());
-                    for (e, ((sn, sd), (nn, nd))) in sn.iter_mut().zip(sd).zip(next).enumerate() {
-                        let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
-                        *sn = nn + n;
-                        *sd = nd + d;
-                    }
-                }
-                zeroed(&mut self.pre_num, w);
-                zeroed(&mut self.pre_den, w);
-                let others = self.suf_num[w..used]
-                    .chunks_exact_mut(w)
-                    .zip(self.suf_den[w..used].chunks_exact(w));
-                for (r, (on, od)) in others.enumerate() {
-                    let v = row(r);
-                    let pre = self.pre_num.iter_mut().zip(self.pre_den.iter_mut());
-                    for (e, ((p, od), (pn, pd))) in on.iter_mut().zip(od).zip(pre).enumerate() {
-                        let ve = std::array::from_fn(|k| v[k][e]);
-                        let b = ratio(*pn + *p, *pd + od);
-                        let (n, d) = F::term(ve);
-                        *pn += n;
-                        *pd += d;
-                        *p = if keep_base { b } else { F::sample(ve, b) };
-                    }
-                }
+                self.leave_one_out::<K, F>(inputs, rows, width, keep_base)
             }
         }
         if let Output::Sums(out) = output {
-            let terms = &self.suf_num[w..used];
-            if comps == 1 {
-                row_sums(&mut out[..rows], w, 0.0, [Rows::new(terms, w)], |[p]| p);
-            } else {
-                for (x, p) in out[..rows * comps]
-                    .chunks_exact_mut(comps)
-                    .zip(terms.chunks_exact(w))
-                {
-                    x.fill(0.0);
-                    for pt in p.chunks_exact(comps) {
-                        for (xc, pc) in x.iter_mut().zip(pt) {
-                            *xc += pc;
-                        }
-                    }
+            self.write_sums(out, rows, width, comps);
+        }
+    }
+
+    /// The samples (or, keeping baselines, the zero baseline) without a baseline.
+    #[inline(always)]
+    fn no_baseline<const K: usize, F: Formula<K>>(
+        &mut self,
+        inputs: [Rows<'_>; K],
+        rows: usize,
+        width: usize,
+        keep_base: bool,
+    ) {
+        let w = width;
+        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
+        let used = (rows + 1) * w;
+        if keep_base {
+            self.suf_num[..w].fill(0.0);
+            self.shared_base = true;
+        } else {
+            for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
+                let v = row(r);
+                for (e, p) in p.iter_mut().enumerate() {
+                    *p = F::plain(std::array::from_fn(|k| v[k][e]));
                 }
             }
         }
     }
 
+    /// The plug-in fit: one baseline from every trajectory, then the samples (or the baseline).
+    #[inline(always)]
+    fn plug_in<const K: usize, F: Formula<K>>(
+        &mut self,
+        inputs: [Rows<'_>; K],
+        rows: usize,
+        width: usize,
+        keep_base: bool,
+    ) {
+        let w = width;
+        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
+        let used = (rows + 1) * w;
+        zeroed(&mut self.pre_num, w);
+        zeroed(&mut self.pre_den, w);
+        for r in 0..rows {
+            let v = row(r);
+            for (e, (pn, pd)) in self.pre_num.iter_mut().zip(&mut self.pre_den).enumerate() {
+                let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
+                *pn += n;
+                *pd += d;
+            }
+        }
+        for (b, d) in self.pre_num.iter_mut().zip(&self.pre_den) {
+            *b = ratio(*b, *d);
+        }
+        if keep_base {
+            self.suf_num[..w].copy_from_slice(&self.pre_num);
+            self.shared_base = true;
+        } else {
+            for (r, p) in self.suf_num[w..used].chunks_exact_mut(w).enumerate() {
+                let v = row(r);
+                for (e, (p, b)) in p.iter_mut().zip(&self.pre_num).enumerate() {
+                    *p = F::sample(std::array::from_fn(|k| v[k][e]), *b);
+                }
+            }
+        }
+    }
+
+    /// The leave-one-out fit: suffix sums of the fit's terms, then one pass that keeps prefix
+    /// sums, so that trajectory r's baseline uses every trajectory but r.
+    #[inline(always)]
+    fn leave_one_out<const K: usize, F: Formula<K>>(
+        &mut self,
+        inputs: [Rows<'_>; K],
+        rows: usize,
+        width: usize,
+        keep_base: bool,
+    ) {
+        let w = width;
+        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| inputs[k].row(r, w)) };
+        let used = (rows + 1) * w;
+        grow(&mut self.suf_den, used);
+        // Rows 0..rows are overwritten; row `rows` is the empty sum.
+        self.suf_num[rows * w..used].fill(0.0);
+        self.suf_den[rows * w..used].fill(0.0);
+        for r in (0..rows).rev() {
+            let v = row(r);
+            let (sn, sn_next) = self.suf_num[r * w..(r + 2) * w].split_at_mut(w);
+            let (sd, sd_next) = self.suf_den[r * w..(r + 2) * w].split_at_mut(w);
+            let next = sn_next.iter().zip(sd_next.iter());
+            for (e, ((sn, sd), (nn, nd))) in sn.iter_mut().zip(sd).zip(next).enumerate() {
+                let (n, d) = F::term(std::array::from_fn(|k| v[k][e]));
+                *sn = nn + n;
+                *sd = nd + d;
+            }
+        }
+        zeroed(&mut self.pre_num, w);
+        zeroed(&mut self.pre_den, w);
+        let others = self.suf_num[w..used]
+            .chunks_exact_mut(w)
+            .zip(self.suf_den[w..used].chunks_exact(w));
+        for (r, (on, od)) in others.enumerate() {
+            let v = row(r);
+            let pre = self.pre_num.iter_mut().zip(self.pre_den.iter_mut());
+            for (e, ((p, od), (pn, pd))) in on.iter_mut().zip(od).zip(pre).enumerate() {
+                let ve = std::array::from_fn(|k| v[k][e]);
+                let b = ratio(*pn + *p, *pd + od);
+                let (n, d) = F::term(ve);
+                *pn += n;
+                *pd += d;
+                *p = if keep_base { b } else { F::sample(ve, b) };
+            }
+        }
+    }
+
+    /// Sums each trajectory's sample terms over its steps into `out` (`comps` per trajectory).
+    #[inline(always)]
+    fn write_sums(&self, out: &mut [f64], rows: usize, width: usize, comps: usize) {
+        let (w, used) = (width, (rows + 1) * width);
+        let terms = &self.suf_num[w..used];
+        if comps == 1 {
+            row_sums(&mut out[..rows], w, 0.0, [Rows::new(terms, w)], |[p]| p);
+        } else {
+            for (x, p) in out[..rows * comps]
+                .chunks_exact_mut(comps)
+                .zip(terms.chunks_exact(w))
+            {
+                x.fill(0.0);
+                for pt in p.chunks_exact(comps) {
+                    for (xc, pc) in x.iter_mut().zip(pt) {
+                        *xc += pc;
+                    }
+                }
+            }
+        }
+    }
     /// The baselines left by [`Output::Baselines`]: trajectory `r` uses
     /// `buffer[r · stride..][..width]`.
     pub(crate) fn baselines(&self, width: usize) -> Rows<'_> {

@@ -154,25 +154,7 @@ impl Estimator {
     ) -> Result<(), EstimatorError> {
         validate(batch, 4)?;
         check_baseline(spec.baseline)?;
-        if !(c.is_finite() && c > 0.0) {
-            return Err(EstimatorError::InvalidConstant {
-                what: "c",
-                value: c,
-            });
-        }
-        if dc_dsigma.len() != batch.dim_w {
-            return Err(EstimatorError::DimensionMismatch {
-                what: "dc_dsigma",
-                expected: batch.dim_w,
-                found: dc_dsigma.len(),
-            });
-        }
-        if let Some(&value) = dc_dsigma.iter().find(|x| !x.is_finite()) {
-            return Err(EstimatorError::InvalidConstant {
-                what: "dc/dsigma",
-                value,
-            });
-        }
+        check_surrogate_constants(batch, c, dc_dsigma)?;
         let n = batch.n;
         let m = batch.dim_v;
         let l = batch.dim_w;
@@ -221,25 +203,7 @@ impl Estimator {
             f.push(scale * (dot(&ga, d_b) + dot(&gb, d_a) - g_ab * dc_dsigma[j] / c));
         }
 
-        // Delta-method samples around the full-batch means.
-        let g_bar = out.grad_v.mean();
-        let d_bar = out.mixed.mean();
-        let zs = out.grad_w_l.reset(n, l);
-        for i in 0..n {
-            let gi = &out.grad_v.samples()[i * m..(i + 1) * m];
-            let di = &out.mixed.samples()[i * l * m..(i + 1) * l * m];
-            for j in 0..l {
-                let scale = batch.sigma[j] / (4.0 * mf * c);
-                let ratio = dc_dsigma[j] / c;
-                let mut lin = 0.0;
-                for k in 0..m {
-                    let dj = d_bar[j * m + k];
-                    let dg = 2.0 * dj - 2.0 * g_bar[k] * ratio;
-                    lin += dg * (gi[k] - g_bar[k]) + 2.0 * g_bar[k] * (di[j * m + k] - dj);
-                }
-                zs[i * l + j] = f[j] + scale * lin;
-            }
-        }
+        delta_method_samples(batch, (c, dc_dsigma), &f, out);
         let result = out.grad_w_l.finish_with_mean(&f);
         if !out.surrogate.is_finite() {
             return Err(EstimatorError::NonFinite {
@@ -304,5 +268,64 @@ impl Estimator {
         let c = penalty_c(task, sigma)?;
         let dc = dc_dsigma(task, sigma)?;
         self.surrogate_gradient(batch, spec, c, &[dc], out)
+    }
+}
+/// Checks the penalty `c > 0` and its derivatives `∂c/∂σ_j` (one per exploration parameter,
+/// finite) that the surrogate gradient takes.
+fn check_surrogate_constants(
+    batch: &Batch,
+    c: f64,
+    dc_dsigma: &[f64],
+) -> Result<(), EstimatorError> {
+    if !(c.is_finite() && c > 0.0) {
+        return Err(EstimatorError::InvalidConstant {
+            what: "c",
+            value: c,
+        });
+    }
+    if dc_dsigma.len() != batch.dim_w {
+        return Err(EstimatorError::DimensionMismatch {
+            what: "dc_dsigma",
+            expected: batch.dim_w,
+            found: dc_dsigma.len(),
+        });
+    }
+    if let Some(&value) = dc_dsigma.iter().find(|x| !x.is_finite()) {
+        return Err(EstimatorError::InvalidConstant {
+            what: "dc/dsigma",
+            value,
+        });
+    }
+    Ok(())
+}
+
+/// The delta-method samples of ∇_w L around the full-batch means: the linearisation of `f`
+/// (the cross-fitted ∇_w L) in each trajectory's ∇_v J and ∂_σ∇_v J samples, written into
+/// `out.grad_w_l`; `(c, ∂c/∂σ)` as in [`Estimator::surrogate_gradient`].
+fn delta_method_samples(
+    batch: &Batch,
+    (c, dc_dsigma): (f64, &[f64]),
+    f: &[f64],
+    out: &mut SurrogateEstimate,
+) {
+    let (n, m, l) = (batch.n, batch.dim_v, batch.dim_w);
+    let mf = m as f64;
+    let g_bar = out.grad_v.mean();
+    let d_bar = out.mixed.mean();
+    let zs = out.grad_w_l.reset(n, l);
+    for i in 0..n {
+        let gi = &out.grad_v.samples()[i * m..(i + 1) * m];
+        let di = &out.mixed.samples()[i * l * m..(i + 1) * l * m];
+        for j in 0..l {
+            let scale = batch.sigma[j] / (4.0 * mf * c);
+            let ratio = dc_dsigma[j] / c;
+            let mut lin = 0.0;
+            for k in 0..m {
+                let dj = d_bar[j * m + k];
+                let dg = 2.0 * dj - 2.0 * g_bar[k] * ratio;
+                lin += dg * (gi[k] - g_bar[k]) + 2.0 * g_bar[k] * (di[j * m + k] - dj);
+            }
+            zs[i * l + j] = f[j] + scale * lin;
+        }
     }
 }

@@ -7,19 +7,8 @@
 
 use sepg_estimators::EstimatorError;
 use sepg_estimators::proven::{ProvenWidths, chi2_psi1_norm, psi1_width, psi2_width};
+use sepg_testkit::simpson;
 use statrs::function::gamma::ln_gamma;
-
-/// Composite Simpson's rule of `f` on `[a, b]` with `2m` intervals.
-pub fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, m: usize) -> f64 {
-    let n = 2 * m;
-    let h = (b - a) / n as f64;
-    let mut sum = f(a) + f(b);
-    for i in 1..n {
-        let w = if i % 2 == 1 { 4.0 } else { 2.0 };
-        sum += w * f(a + i as f64 * h);
-    }
-    sum * h / 3.0
-}
 
 /// `E exp(X²/K²)` for `X ~ N(0, s²)` by quadrature (`+∞` when the integral diverges).
 fn gaussian_psi2_moment(s: f64, k: f64) -> f64 {
@@ -30,7 +19,7 @@ fn gaussian_psi2_moment(s: f64, k: f64) -> f64 {
     // The integrand is below e^{-60} beyond |x| = √(60/rate).
     let l = (60.0 / rate).sqrt();
     let norm = 1.0 / (s * (2.0 * std::f64::consts::PI).sqrt());
-    simpson(|x| norm * (-rate * x * x).exp(), -l, l, 20_000)
+    simpson(|x| norm * (-rate * x * x).exp(), -l, l, 40_000)
 }
 
 /// `E exp(|Q − n|/K)` for `Q ~ χ²_n` by quadrature in `u = √Q` (density `2u f(u²)`, smooth
@@ -58,7 +47,7 @@ fn chi2_abs_moment(n: usize, k: f64) -> f64 {
     while f(u_max) > (-60.0f64).exp() {
         u_max *= 1.1;
     }
-    simpson(f, 0.0, root, 20_000) + simpson(f, root, u_max, 40_000)
+    simpson(f, 0.0, root, 40_000) + simpson(f, root, u_max, 80_000)
 }
 
 /// The smallest `K` with `moment(K) ≤ 2`, by bisection (`moment` decreasing in `K`).

@@ -9,6 +9,9 @@
 //!   engine producing [`Batch`]es.
 //! - [`monte_carlo`]: Monte Carlo estimates of `J` and of paired differences of `J`.
 //! - [`oracle`]: exact LQG oracles.
+
+#![deny(missing_docs)]
+
 pub mod batch;
 pub mod env;
 pub mod features;

@@ -14,6 +14,9 @@
 //!
 //! Bad input never panics and never returns NaN: every error is raised as one of the
 //! exception classes of `sepg.errors`, whose input errors are also `ValueError`s.
+
+#![deny(missing_docs)]
+
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;

@@ -21,6 +21,8 @@
 //! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
 //! [`Error`]; nothing here prints.
 
+#![deny(missing_docs)]
+
 pub mod audit;
 pub mod error;
 pub mod estimate;
@@ -35,3 +37,6 @@ pub mod spec;
 pub mod sweep;
 
 pub use error::{Error, Result};
+pub use run::{RunOptions, Silent, resume, start};
+pub use spec::{Resolved, RunSpec};
+pub use sweep::{SweepOptions, SweepSpec};

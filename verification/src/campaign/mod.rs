@@ -37,7 +37,7 @@ use sepg_bounds::high_probability::{self as hp, HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use sepg_bounds::{exploring, pirotta, rigorous, v_update, w_update};
-use sepg_certified::{self as certified, Certified};
+use sepg_certified::{self as certified, Certified, CertifiedStep};
 
 use sepg_algo::solver::realise::{CoordinateBound, realise};
 
@@ -579,11 +579,24 @@ type Outcomes = (f64, StepOutcome, Certified);
 
 /// Runs form `form` on a case in `f64`; `None` when an input is rejected (overflow).
 fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
-    let (s, g, j, l) = (c.sigma, &c.grad_v[..], c.grad_w_j, c.grad_w_l);
-    let sa = HpForm::SignAware;
-    let th = HpForm::Thesis;
-    let hp_c_max = |b: Option<HighProbabilityBound>| b.map_or(0.0, |b| b.c_max());
     let result = match form {
+        3..=7 | 10 => hp_outcomes(form, c, k)?,
+        11 => exploring_outcomes(c, k)?,
+        ADAPTIVE => adaptive_outcomes(c, k)?,
+        _ => exact_gradient_outcomes(form, c, k)?,
+    };
+    result
+        .1
+        .c_max()
+        .is_none_or(f64::is_finite)
+        .then_some(result)
+}
+
+/// Forms 0–2, 8 and 9: the steps of Theorems 4.2, 4.3 (along ∇J and ∇L) and the rigorous
+/// w-steps, on exact gradients.
+fn exact_gradient_outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
+    let (s, g, j, l) = (c.sigma, &c.grad_v[..], c.grad_w_j, c.grad_w_l);
+    Some(match form {
         0 => {
             let req = c.requirement.of(v_update::c_max(k, s, g).ok()?);
             (
@@ -608,6 +621,34 @@ fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
                 certified::w_safe_step_along_l(k, s, j, l, req).ok()?,
             )
         }
+        8 => {
+            let c_max = rigorous::safe_step_along_j(k, s, j, 0.0).ok()?.c_max()?;
+            let req = c.requirement.of(c_max);
+            (
+                req,
+                rigorous::safe_step_along_j(k, s, j, req).ok()?,
+                certified::rigorous_safe_step_along_j(k, s, j, req).ok()?,
+            )
+        }
+        _ => {
+            let c_max = rigorous::safe_step_along_l(k, s, j, l, 0.0).ok()?.c_max()?;
+            let req = c.requirement.of(c_max);
+            (
+                req,
+                rigorous::safe_step_along_l(k, s, j, l, req).ok()?,
+                certified::rigorous_safe_step_along_l(k, s, j, l, req).ok()?,
+            )
+        }
+    })
+}
+
+/// Forms 3–7 and 10: the high-probability steps of Theorems 4.7–4.9, sign-aware or as printed.
+fn hp_outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
+    let (s, g, j, l) = (c.sigma, &c.grad_v[..], c.grad_w_j, c.grad_w_l);
+    let sa = HpForm::SignAware;
+    let th = HpForm::Thesis;
+    let hp_c_max = |b: Option<HighProbabilityBound>| b.map_or(0.0, |b| b.c_max());
+    Some(match form {
         3 | 4 => {
             let form = if form == 3 { sa } else { th };
             let b = HighProbabilityBound::v_update(k, s, g, c.eps_v).ok()?;
@@ -628,7 +669,7 @@ fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
                 certified::hp_w_safe_step_along_j(k, s, j, c.eps_j, req, form).ok()?,
             )
         }
-        6 | 7 => {
+        _ => {
             let form = if form == 6 { sa } else { th };
             let b = HighProbabilityBound::w_along_l(k, s, j, c.eps_j, l, c.eps_l).ok()?;
             let req = c.requirement.of(hp_c_max(b));
@@ -639,62 +680,45 @@ fn outcomes(form: usize, c: &Case, k: &TaskConstants) -> Option<Outcomes> {
                     .ok()?,
             )
         }
-        11 => {
-            // the exploring C_max, or Theorem 4.3's when |∇̂_wJ| ≤ ε_J makes it 0, so that
-            // negative requirements are drawn too
-            let own = exploring::w_exploring_step(k, s, j, c.eps_j, l, 0.0)
-                .ok()?
-                .c_max()?;
-            let c_max = if own > 0.0 {
-                own
-            } else {
-                w_update::c_max(k, s, j).ok()?
-            };
-            let req = c.requirement.of(c_max);
-            (
-                req,
-                exploring::w_exploring_step(k, s, j, c.eps_j, l, req).ok()?,
-                certified::exploring_safe_step(k, s, j, c.eps_j, l, req).ok()?,
-            )
-        }
-        ADAPTIVE => {
-            let (alpha, guarantee) = match pirotta::optimal_step(k, s, g).ok()? {
-                pirotta::AdaptiveStep::Step { alpha, guarantee } => (alpha, guarantee),
-                _ => return None,
-            };
-            let step = StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
-                c_max: guarantee,
-                vertex: alpha,
-                lambda: Some(0.0),
-                lo: alpha,
-                hi: alpha,
-            });
-            (guarantee, step, certified::adaptive_step(k, s, g).ok()?)
-        }
-        8 => {
-            let c_max = rigorous::safe_step_along_j(k, s, j, 0.0).ok()?.c_max()?;
-            let req = c.requirement.of(c_max);
-            (
-                req,
-                rigorous::safe_step_along_j(k, s, j, req).ok()?,
-                certified::rigorous_safe_step_along_j(k, s, j, req).ok()?,
-            )
-        }
-        _ => {
-            let c_max = rigorous::safe_step_along_l(k, s, j, l, 0.0).ok()?.c_max()?;
-            let req = c.requirement.of(c_max);
-            (
-                req,
-                rigorous::safe_step_along_l(k, s, j, l, req).ok()?,
-                certified::rigorous_safe_step_along_l(k, s, j, l, req).ok()?,
-            )
-        }
+    })
+}
+
+/// Form 11: the exploring w-step.
+fn exploring_outcomes(c: &Case, k: &TaskConstants) -> Option<Outcomes> {
+    let (s, j, l) = (c.sigma, c.grad_w_j, c.grad_w_l);
+    // the exploring C_max, or Theorem 4.3's when |∇̂_wJ| ≤ ε_J makes it 0, so that
+    // negative requirements are drawn too
+    let own = exploring::w_exploring_step(k, s, j, c.eps_j, l, 0.0)
+        .ok()?
+        .c_max()?;
+    let c_max = if own > 0.0 {
+        own
+    } else {
+        w_update::c_max(k, s, j).ok()?
     };
-    result
-        .1
-        .c_max()
-        .is_none_or(f64::is_finite)
-        .then_some(result)
+    let req = c.requirement.of(c_max);
+    Some((
+        req,
+        exploring::w_exploring_step(k, s, j, c.eps_j, l, req).ok()?,
+        certified::exploring_safe_step(k, s, j, c.eps_j, l, req).ok()?,
+    ))
+}
+
+/// The adaptive step of Theorem 3.10 / Corollary 3.11.
+fn adaptive_outcomes(c: &Case, k: &TaskConstants) -> Option<Outcomes> {
+    let (s, g) = (c.sigma, &c.grad_v[..]);
+    let (alpha, guarantee) = match pirotta::optimal_step(k, s, g).ok()? {
+        pirotta::AdaptiveStep::Step { alpha, guarantee } => (alpha, guarantee),
+        _ => return None,
+    };
+    let step = StepOutcome::Feasible(sepg_bounds::outcome::SafeInterval {
+        c_max: guarantee,
+        vertex: alpha,
+        lambda: Some(0.0),
+        lo: alpha,
+        hi: alpha,
+    });
+    Some((guarantee, step, certified::adaptive_step(k, s, g).ok()?))
 }
 
 /// The exact bound of form `form` at the step x.
@@ -896,31 +920,15 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
     }
     match certified {
         Certified::Step(st) => {
-            tally_applied(t, form, index, c, &k, step, required, ex);
-            t.certified_steps += 1;
-            t.tight_certified_steps += u64::from(matches!(c.family, Family::Tight(_)));
-            if st.by_error_bound {
-                t.by_error_bound += 1;
-            } else {
-                t.by_interval += 1;
-            }
-            if st.ulps_moved > 0 {
-                t.moved += 1;
-                if st.ulps_moved > t.max_ulps {
-                    t.max_ulps = st.ulps_moved;
-                    t.largest_move = Some(format!(
-                        "case {index} {c:?}: C {required:e}, f64 interval {:?}, certified {step:e}",
-                        st.interval
-                    ));
-                }
-            }
-            if b.certainly_lt(&cc) {
-                t.certified_violations += 1;
-                failure = Some("certified step violates C");
-            } else if !b.certainly_ge(&cc) {
-                t.undecided += 1;
-                failure = Some("undecided at 256 bits");
-            }
+            let applied = Applied {
+                form,
+                index,
+                c,
+                k: &k,
+                step,
+                required,
+            };
+            failure = tally_step(t, &st, &applied, ex, &b, &cc).or(failure);
         }
         Certified::Uncertifiable { .. } => t.uncertifiable += 1,
         _ => {}
@@ -933,6 +941,63 @@ fn tally(t: &mut FormTally, form: usize, index: u64, c: &Case, ex: &Exact) {
             enclosure.hi()
         ));
     }
+}
+
+/// One certified step of the campaign, with the case it came from.
+struct Applied<'a> {
+    form: usize,
+    index: u64,
+    c: &'a Case,
+    k: &'a TaskConstants,
+    step: f64,
+    required: f64,
+}
+
+/// Tallies a certified step: how it was certified, how far it moved, whether its exact bound
+/// `b` meets the requirement `cc`, and the same step applied to a parameter value; returns the
+/// failure to report, if any.
+fn tally_step(
+    t: &mut FormTally,
+    st: &CertifiedStep,
+    a: &Applied<'_>,
+    ex: &Exact,
+    b: &Mp,
+    cc: &Mp,
+) -> Option<&'static str> {
+    let Applied {
+        form,
+        index,
+        c,
+        k,
+        step,
+        required,
+    } = *a;
+    tally_applied(t, form, index, c, k, step, required, ex);
+    t.certified_steps += 1;
+    t.tight_certified_steps += u64::from(matches!(c.family, Family::Tight(_)));
+    if st.by_error_bound {
+        t.by_error_bound += 1;
+    } else {
+        t.by_interval += 1;
+    }
+    if st.ulps_moved > 0 {
+        t.moved += 1;
+        if st.ulps_moved > t.max_ulps {
+            t.max_ulps = st.ulps_moved;
+            t.largest_move = Some(format!(
+                "case {index} {c:?}: C {required:e}, f64 interval {:?}, certified {step:e}",
+                st.interval
+            ));
+        }
+    }
+    if b.certainly_lt(cc) {
+        t.certified_violations += 1;
+        return Some("certified step violates C");
+    } else if !b.certainly_ge(cc) {
+        t.undecided += 1;
+        return Some("undecided at 256 bits");
+    }
+    None
 }
 
 /// Whether `certified` carries the `f64` outcome `uncertified` of the same inputs bit for bit:

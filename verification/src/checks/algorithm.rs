@@ -13,9 +13,10 @@ use sepg_mdp::oracle::ClosedFormOracle;
 use crate::check::{
     Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Tolerance, fmt_f64,
 };
-use crate::checks::sampled::{Freq, frequency_outcome};
+use crate::checks::sampled::FAMILY_ALPHA;
 use crate::lqg::{HORIZON, Preset, Task};
 use crate::search::{Comparison, fixed};
+use crate::stats::{Freq, frequency_outcome};
 
 fn env(preset: Preset, clipped: bool) -> Option<AnyEnv> {
     let model = match preset {
@@ -330,7 +331,7 @@ fn sampled_violations(ctx: &CheckContext<'_>) -> Evaluation {
             });
         }
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 fn v_star_claims(ctx: &CheckContext<'_>) -> Evaluation {
@@ -521,32 +522,58 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str, ground_truth: &s
     }
 }
 
+const EXACT: &str =
+    "J of the recorded parameters by the clipped DP oracle (sepg-algo's exact mode)";
+const BUDGET_TRUTH: &str = "the budget recomputed from the DP oracle's J at the recorded parameters, \
+        B^t = J(v^{t+1}, w^t) − J(v⁰, w⁰) + J(v^t, w_T^t) − J(v⁰, w_T⁰) (target terms for LV, ZV), \
+        not the budget the algorithm keeps";
+
 /// The checks of this module, in registry order.
 pub(crate) fn checks() -> Vec<Check> {
-    let exact = "J of the recorded parameters by the clipped DP oracle (sepg-algo's exact mode)";
+    vec![
+        mi_monotone_check(),
+        lb_i_check(),
+        type_ii_budget_check(),
+        lv_budget_check(),
+        initial_budget_runs_check(),
+        sampled_violations_check(),
+        v_star_claims_check(),
+        table_5_1_check(),
+    ]
+}
+
+/// The check `sepg-mi-monotone-exact`.
+fn mi_monotone_check() -> Check {
     let mi = meta(
         "sepg-mi-monotone-exact",
         "SEPG-MI (Table 4.1, C = 0) is monotone with exact gradients",
         "Section 4.2.1, Table 4.1, Algorithm 4.3",
         "J(θ^{t+1}) ≥ J(θ^t) at every iteration.",
-        exact,
+        EXACT,
     );
+    Check::new(mi, mi_monotone)
+}
+
+/// The check `sepg-lb-i-exact`.
+fn lb_i_check() -> Check {
     let lb1 = meta(
         "sepg-lb-i-exact",
         "SEPG LB-I (C = J(θ⁰) − J(θ^t)) stays above J(θ⁰) with exact gradients",
         "Section 4.2.1, Table 4.1, Algorithm 4.3",
         "J(θ^t) ≥ J(θ⁰) at every iteration (ν = 0.5).",
-        exact,
+        EXACT,
     );
-    let budget_truth = "the budget recomputed from the DP oracle's J at the recorded parameters, \
-        B^t = J(v^{t+1}, w^t) − J(v⁰, w⁰) + J(v^t, w_T^t) − J(v⁰, w_T⁰) (target terms for LV, ZV), \
-        not the budget the algorithm keeps";
+    Check::new(lb1, lb_i)
+}
+
+/// The check `sepg-type-ii-budget-exact`.
+fn type_ii_budget_check() -> Check {
     let mut b2 = meta(
         "sepg-type-ii-budget-exact",
         "SEPG LB-II and ZV keep the budget non-negative with exact gradients (Theorem 4.1)",
         "Section 4.2.2, Table 4.1, Algorithm 4.3",
         "B^t ≥ 0 at every iteration (B⁰ = 0), hence type-II safety by Theorem 4.1.",
-        budget_truth,
+        BUDGET_TRUTH,
     );
     b2.notes = "Holds. LV is checked separately (sepg-lv-budget-exact).".into();
     b2.basis = "independent computation: 10,000-iteration exact runs of LB-II and ZV on both \
@@ -556,12 +583,17 @@ pub(crate) fn checks() -> Vec<Check> {
         neglected terms of Theorem 4.3 for Δw < 0) but not ZV's target charge \
         J(v^t, −∞) − J(v^{t−1}, −∞), which no theorem bounds"
         .into();
+    Check::new(b2, type_ii_budget)
+}
+
+/// The check `sepg-lv-budget-exact`.
+fn lv_budget_check() -> Check {
     let mut lv = meta(
         "sepg-lv-budget-exact",
         "SEPG-LV keeps the budget non-negative with exact gradients (Theorem 4.1, Table 4.1)",
         "Section 4.4.2, Table 4.1, Algorithm 4.3",
         "B^t ≥ 0 at every iteration (B⁰ = 0) for the low-variance target.",
-        budget_truth,
+        BUDGET_TRUTH,
     );
     lv.sampling = "exact-gradient SEPG-LV on clipped lqg, σ⁰ = 1, v⁰ = −0.1, H = 20, γ = 0.99, \
         560 iterations in both modes (past iteration 531)"
@@ -578,6 +610,11 @@ pub(crate) fn checks() -> Vec<Check> {
         comes from an independent 10,000-iteration exact run \
         (crates/algo/tests/suite/exact.rs::lv_budget_goes_negative_clipped_dp_10000_iterations)"
         .into();
+    Check::new(lv, lv_budget)
+}
+
+/// The check `thm-4.1-initial-budget`.
+fn initial_budget_runs_check() -> Check {
     let mut b0 = meta(
         "thm-4.1-initial-budget",
         "Theorem 4.1 with an initial budget B⁰ > 0 (Section 4.4.4, Mountain Car uses B⁰ = 1)",
@@ -601,6 +638,11 @@ pub(crate) fn checks() -> Vec<Check> {
         lets the steps lose up to B; that the algorithm does lose performance below J_B comes \
         from the exact runs of this check (DP oracle, independent of the algorithm's own J)"
         .into();
+    Check::new(b0, initial_budget_runs)
+}
+
+/// The check `sepg-sampled-violations`.
+fn sampled_violations_check() -> Check {
     let mut sv = meta(
         "sepg-sampled-violations",
         "SEPG-MI and LB-I with sampled gradients: realised per-iteration violations vs δ",
@@ -624,6 +666,11 @@ pub(crate) fn checks() -> Vec<Check> {
     sv.false_alarm_rate = "1e-3 family-wise: one-sided Clopper–Pearson test, Bonferroni across \
         the four runs (iterations of one run are treated as independent trials)"
         .into();
+    Check::new(sv, sampled_violations)
+}
+
+/// The check `claim-v-star`.
+fn v_star_claims_check() -> Check {
     let mut vs = meta(
         "claim-v-star",
         "Numerical claims v* ≈ −0.615 and J(v*, −∞) ≈ −7.753 (Chapter 5)",
@@ -650,6 +697,11 @@ pub(crate) fn checks() -> Vec<Check> {
         and J(v*) = −E[s₀²]P − γ/(1−γ)·P·η₀² in closed form; the check compares the printed \
         values with the oracle's Riccati iteration"
         .into();
+    Check::new(vs, v_star_claims)
+}
+
+/// The check `table-5.1-ordering`.
+fn table_5_1_check() -> Check {
     let mut t51 = meta(
         "table-5.1-ordering",
         "Table 5.1's qualitative ordering",
@@ -679,14 +731,5 @@ pub(crate) fn checks() -> Vec<Check> {
         steps contain MI's at the same θ, and c(σ), d(σ) decrease in σ, so larger σ allows \
         larger steps"
         .into();
-    vec![
-        Check::new(mi, mi_monotone),
-        Check::new(lb1, lb_i),
-        Check::new(b2, type_ii_budget),
-        Check::new(lv, lv_budget),
-        Check::new(b0, initial_budget_runs),
-        Check::new(sv, sampled_violations),
-        Check::new(vs, v_star_claims),
-        Check::new(t51, table_5_1),
-    ]
+    Check::new(t51, table_5_1)
 }

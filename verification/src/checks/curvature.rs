@@ -134,26 +134,14 @@ fn curvature_presets(ctx: &CheckContext<'_>) -> Evaluation {
                     let (vv, ww) = (hess[(0, 0)], hess[(1, 1)]);
                     let at = format!("v = {v:.4}, σ = {sigma:.4}");
                     let label = format!("{preset:?}, H = {h}, {at}");
-                    comparisons.push((
-                        format!("{label}: −∂²J/∂v² ≤ 2c (non-positive rewards)"),
-                        Comparison::new(-vv, c_np),
-                    ));
-                    comparisons.push((
-                        format!("{label}: |∂²J/∂v²| ≤ 2c (two-sided)"),
-                        Comparison::new(vv.abs(), c_ts),
-                    ));
-                    comparisons.push((
-                        format!("{label}: −∂²J/∂w² ≤ 2d (non-positive rewards)"),
-                        Comparison::new(-ww, d_np),
-                    ));
-                    comparisons.push((
-                        format!("{label}: |∂²J/∂w²| ≤ 2d (two-sided)"),
-                        Comparison::new(ww.abs(), d_ts),
-                    ));
-                    tightest[0].record(-vv, c_np, &at);
-                    tightest[1].record(vv.abs(), c_ts, &at);
-                    tightest[2].record(-ww, d_np, &at);
-                    tightest[3].record(ww.abs(), d_ts, &at);
+                    compare_point(
+                        &label,
+                        &at,
+                        (vv, ww),
+                        [c_np, c_ts, d_np, d_ts],
+                        &mut comparisons,
+                        &mut tightest,
+                    );
                     // the DP's ∂²J/∂w² against a central difference of its ∂J/∂w
                     if let Some(fd) = central_difference_ww(&task, v, w, h) {
                         fd_error = fd_error.max((fd - ww).abs() / e.j.abs().max(1.0));
@@ -183,6 +171,38 @@ fn curvature_presets(ctx: &CheckContext<'_>) -> Evaluation {
         value: fmt_f64(fd_error),
     });
     eval
+}
+
+/// Compares the DP's ∂²J/∂v² and ∂²J/∂w² at one grid point with twice the penalties
+/// `[c (ρ = 1/2), c (ρ = 1), d (ρ = 1/2), d (ρ = 1)]`, and records how close each comes.
+fn compare_point(
+    label: &str,
+    at: &str,
+    (vv, ww): (f64, f64),
+    [c_np, c_ts, d_np, d_ts]: [f64; 4],
+    comparisons: &mut Vec<(String, Comparison)>,
+    tightest: &mut [Tightest; 4],
+) {
+    comparisons.push((
+        format!("{label}: −∂²J/∂v² ≤ 2c (non-positive rewards)"),
+        Comparison::new(-vv, c_np),
+    ));
+    comparisons.push((
+        format!("{label}: |∂²J/∂v²| ≤ 2c (two-sided)"),
+        Comparison::new(vv.abs(), c_ts),
+    ));
+    comparisons.push((
+        format!("{label}: −∂²J/∂w² ≤ 2d (non-positive rewards)"),
+        Comparison::new(-ww, d_np),
+    ));
+    comparisons.push((
+        format!("{label}: |∂²J/∂w²| ≤ 2d (two-sided)"),
+        Comparison::new(ww.abs(), d_ts),
+    ));
+    tightest[0].record(-vv, c_np, at);
+    tightest[1].record(vv.abs(), c_ts, at);
+    tightest[2].record(-ww, d_np, at);
+    tightest[3].record(ww.abs(), d_ts, at);
 }
 
 /// Step in w of the central difference that checks the DP's ∂²J/∂w².
@@ -303,7 +323,6 @@ fn adversarial_tasks(ctx: &CheckContext<'_>) -> Vec<Adversarial> {
     };
     let mut out = Vec::new();
     for h in [1usize, 20] {
-        let discount = |t: usize| GAMMA.powi(t as i32);
         for rewards in [Rewards::NonPositive, Rewards::TwoSided] {
             // r_t = lo on the event, hi elsewhere: lo − hi = −R (non-positive: [−R, 0]) or
             // −2R (two-sided: [−R, R]); −∂²J = (hi − lo) Σ γᵗ ∂²P
@@ -315,67 +334,109 @@ fn adversarial_tasks(ctx: &CheckContext<'_>) -> Vec<Adversarial> {
                 let Some((c2, d2)) = twice_c_d(ctx, &k, h, rewards, sigma) else {
                     continue;
                 };
-                // mean, at v₀ = −0.3
-                let v0 = -0.3;
-                let j_mean = |v: f64| -> f64 {
-                    -spread
-                        * (0..h)
-                            .map(|t| {
-                                discount(t) * mean_event(v, v0, sigma, m_phi, (t + 1) as f64).0
-                            })
-                            .sum::<f64>()
+                let at = Point {
+                    h,
+                    rewards,
+                    sigma,
+                    spread,
+                    step: FD_STEP / (h as f64).sqrt(),
                 };
-                let curvature: f64 = spread
-                    * (0..h)
-                        .map(|t| discount(t) * mean_event(v0, v0, sigma, m_phi, (t + 1) as f64).1)
-                        .sum::<f64>();
-                // the sum of n actions moves √n times faster: a step of FD_STEP/√H in its units
-                let step = FD_STEP / (h as f64).sqrt();
-                let dv = step * sigma / m_phi;
-                out.push(Adversarial {
-                    label: format!("mean, H = {h}, {rewards:?}, σ = {sigma}"),
-                    curvature,
-                    bound: c2,
-                    fraction: (two_phi_1, two_phi_1),
-                    central_difference: -(j_mean(v0 + dv) - 2.0 * j_mean(v0) + j_mean(v0 - dv))
-                        / (dv * dv),
-                });
-                // log σ, at w₀ = ln σ (the event is defined at σ₀ = σ; J depends on w − w₀)
-                let j_w = |u: f64| -> Option<f64> {
-                    let mut sum = 0.0;
-                    for t in 0..h {
-                        sum += discount(t) * w_event(u, (t + 1) as f64)?.0;
-                    }
-                    Some(-spread * sum)
-                };
-                let mut curvature = 0.0;
-                for t in 0..h {
-                    let Some((_, d)) = w_event(0.0, (t + 1) as f64) else {
-                        return vec![];
-                    };
-                    curvature += spread * discount(t) * d;
-                }
-                let (Some(up), Some(mid), Some(down)) = (j_w(step), j_w(0.0), j_w(-step)) else {
+                out.push(mean_task(&at, m_phi, c2, two_phi_1));
+                let Some(task) = log_sigma_task(&at, d2, (kw_4, two_phi_1)) else {
                     return vec![];
                 };
-                // H = 1: exactly K_W/4; H > 1: each step's fraction lies between its n = 1
-                // value K_W/4 and its central-limit value 2φ(1)
-                let fraction = if h == 1 {
-                    (kw_4, kw_4)
-                } else {
-                    (kw_4, two_phi_1)
-                };
-                out.push(Adversarial {
-                    label: format!("log σ, H = {h}, {rewards:?}, σ = {sigma}"),
-                    curvature,
-                    bound: d2,
-                    fraction,
-                    central_difference: -(up - 2.0 * mid + down) / (step * step),
-                });
+                out.push(task);
             }
         }
     }
     out
+}
+
+/// One configuration of the adversarial tasks: horizon, reward form, σ, the reward spread
+/// (hi − lo) on the event, and the finite-difference step in the units of the summed action.
+struct Point {
+    h: usize,
+    rewards: Rewards,
+    sigma: f64,
+    spread: f64,
+    step: f64,
+}
+
+/// γᵗ.
+fn discount(t: usize) -> f64 {
+    GAMMA.powi(t as i32)
+}
+
+/// The adversarial task for the mean at v₀ = −0.3, against twice its penalty `c2`; the sum of n
+/// actions moves √n times faster, so the step is FD_STEP/√H in its units.
+fn mean_task(at: &Point, m_phi: f64, c2: f64, two_phi_1: f64) -> Adversarial {
+    let &Point {
+        h,
+        rewards,
+        sigma,
+        spread,
+        step,
+    } = at;
+    // mean, at v₀ = −0.3
+    let v0 = -0.3;
+    let j_mean = |v: f64| -> f64 {
+        -spread
+            * (0..h)
+                .map(|t| discount(t) * mean_event(v, v0, sigma, m_phi, (t + 1) as f64).0)
+                .sum::<f64>()
+    };
+    let curvature: f64 = spread
+        * (0..h)
+            .map(|t| discount(t) * mean_event(v0, v0, sigma, m_phi, (t + 1) as f64).1)
+            .sum::<f64>();
+    let dv = step * sigma / m_phi;
+    Adversarial {
+        label: format!("mean, H = {h}, {rewards:?}, σ = {sigma}"),
+        curvature,
+        bound: c2,
+        fraction: (two_phi_1, two_phi_1),
+        central_difference: -(j_mean(v0 + dv) - 2.0 * j_mean(v0) + j_mean(v0 - dv)) / (dv * dv),
+    }
+}
+
+/// The adversarial task for log σ, against twice its penalty `d2`; `None` when an event
+/// probability cannot be evaluated.
+fn log_sigma_task(at: &Point, d2: f64, (kw_4, two_phi_1): (f64, f64)) -> Option<Adversarial> {
+    let &Point {
+        h,
+        rewards,
+        sigma,
+        spread,
+        step,
+    } = at;
+    // log σ, at w₀ = ln σ (the event is defined at σ₀ = σ; J depends on w − w₀)
+    let j_w = |u: f64| -> Option<f64> {
+        let mut sum = 0.0;
+        for t in 0..h {
+            sum += discount(t) * w_event(u, (t + 1) as f64)?.0;
+        }
+        Some(-spread * sum)
+    };
+    let mut curvature = 0.0;
+    for t in 0..h {
+        let (_, d) = w_event(0.0, (t + 1) as f64)?;
+        curvature += spread * discount(t) * d;
+    }
+    let (up, mid, down) = (j_w(step)?, j_w(0.0)?, j_w(-step)?);
+    // H = 1: exactly K_W/4; H > 1: each step's fraction lies between its n = 1
+    // value K_W/4 and its central-limit value 2φ(1)
+    let fraction = if h == 1 {
+        (kw_4, kw_4)
+    } else {
+        (kw_4, two_phi_1)
+    };
+    Some(Adversarial {
+        label: format!("log σ, H = {h}, {rewards:?}, σ = {sigma}"),
+        curvature,
+        bound: d2,
+        fraction,
+        central_difference: -(up - 2.0 * mid + down) / (step * step),
+    })
 }
 
 fn curvature_adversarial(ctx: &CheckContext<'_>) -> Evaluation {

@@ -8,8 +8,10 @@ use sepg_bounds::high_probability::{HpForm, w_safe_step_along_l};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_estimators::{Estimator, GradientSpec, Param, SurrogateEstimate, Width};
 
-use super::sampled::{DP_TRUTH, Freq, N, Setting, estimate, frequency_outcome, hp_settings, meta};
+use super::sampled::{DP_TRUTH, FAMILY_ALPHA, N, estimate, hp_settings, meta};
 use crate::check::{Check, CheckContext, Evaluation, Figure};
+use crate::lqg::Setting;
+use crate::stats::{Freq, frequency_outcome};
 
 /// Confidence parameter of every width of the check.
 const DELTA: f64 = 0.2;
@@ -64,43 +66,7 @@ fn exploring_w_step(ctx: &CheckContext<'_>) -> Evaluation {
             };
             let (g, l) = (gw.mean()[0], sur.grad_w_l().mean()[0]);
             for (count, &required) in counts.iter_mut().zip(&requirements) {
-                let Ok(ours) = w_exploring_step(s.k(), s.sigma, g, cw.eps, l, required) else {
-                    continue;
-                };
-                let Some(beta) = ours.chosen_step() else {
-                    continue;
-                };
-                let Some(j1) = s.task.j(s.v, s.w + beta * l) else {
-                    continue;
-                };
-                count.trials += 1;
-                if j1 - s.exact.j < required - tol {
-                    count.violations += 1;
-                }
-                let thesis = w_safe_step_along_l(
-                    s.k(),
-                    s.sigma,
-                    g,
-                    cw.eps,
-                    l,
-                    cl.eps,
-                    required,
-                    HpForm::SignAware,
-                );
-                match thesis {
-                    Ok(StepOutcome::Feasible(t))
-                        if t.hi - beta > 1e-9 * beta.abs().max(t.hi.abs()) =>
-                    {
-                        count.shorter += 1;
-                    }
-                    Ok(StepOutcome::BelowNoise) => {
-                        count.thesis_still += 1;
-                        if beta != 0.0 {
-                            count.explores += 1;
-                        }
-                    }
-                    _ => {}
-                }
+                count_batch(count, &s, (g, cw.eps), (l, cl.eps), required, tol);
             }
         }
         for (count, &required) in counts.iter().zip(&requirements) {
@@ -126,9 +92,57 @@ fn exploring_w_step(ctx: &CheckContext<'_>) -> Evaluation {
             });
         }
     }
-    let mut evaluation = frequency_outcome(&tests);
+    let mut evaluation = frequency_outcome(&tests, FAMILY_ALPHA);
     evaluation.figures.extend(figures);
     evaluation
+}
+
+/// Adds one batch to `count`: the exploring w-step for requirement `required` from the
+/// estimates `(∇̂_w J, ε_wJ)` and `(∇̂_w L, ε_wL)`, judged against exact J (tolerance `tol`), and
+/// compared with Theorem 4.9's step.
+fn count_batch(
+    count: &mut Counts,
+    s: &Setting,
+    (g, eps_w): (f64, f64),
+    (l, eps_l): (f64, f64),
+    required: f64,
+    tol: f64,
+) {
+    let Ok(ours) = w_exploring_step(s.k(), s.sigma, g, eps_w, l, required) else {
+        return;
+    };
+    let Some(beta) = ours.chosen_step() else {
+        return;
+    };
+    let Some(j1) = s.task.j(s.v, s.w + beta * l) else {
+        return;
+    };
+    count.trials += 1;
+    if j1 - s.exact.j < required - tol {
+        count.violations += 1;
+    }
+    let thesis = w_safe_step_along_l(
+        s.k(),
+        s.sigma,
+        g,
+        eps_w,
+        l,
+        eps_l,
+        required,
+        HpForm::SignAware,
+    );
+    match thesis {
+        Ok(StepOutcome::Feasible(t)) if t.hi - beta > 1e-9 * beta.abs().max(t.hi.abs()) => {
+            count.shorter += 1;
+        }
+        Ok(StepOutcome::BelowNoise) => {
+            count.thesis_still += 1;
+            if beta != 0.0 {
+                count.explores += 1;
+            }
+        }
+        _ => {}
+    }
 }
 
 /// The checks of this module, in registry order.

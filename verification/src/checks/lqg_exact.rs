@@ -819,6 +819,23 @@ fn meta(id: &str, statement: &str, location: &str, claim: &str) -> CheckMeta {
 
 /// The checks of this module, in registry order.
 pub(crate) fn checks() -> Vec<Check> {
+    vec![
+        thm_3_10_check(),
+        thm_3_14_check(),
+        thm_4_2_check(),
+        thm_4_2_closed_form_check(),
+        thm_4_3_thesis_check(),
+        thm_4_3_rigorous_check(),
+        thm_4_3_neglected_check(),
+        cor_4_4_check(),
+        surrogate_gradient_check(),
+        thm_4_5_check(),
+        eq_4_20_check(),
+    ]
+}
+
+/// The check `thm-3.10-cor-3.11-adaptive-step`.
+fn thm_3_10_check() -> Check {
     let mut t310 = meta(
         "thm-3.10-cor-3.11-adaptive-step",
         "Theorem 3.10 and Corollary 3.11 (Pirotta et al.'s adaptive step)",
@@ -830,6 +847,11 @@ pub(crate) fn checks() -> Vec<Check> {
     t310.notes = "Holds with a large margin (see the penalty ratio). The clipped presets have one \
         mean parameter (m = 1), so ‖·‖₁ = ‖·‖₂ = ‖·‖∞ here."
         .into();
+    Check::new(t310, thm_3_10)
+}
+
+/// The check `thm-3.14-diagonal-step`.
+fn thm_3_14_check() -> Check {
     let mut t314 = meta(
         "thm-3.14-diagonal-step",
         "Theorem 3.14 (Papini et al.'s non-scalar step)",
@@ -839,6 +861,11 @@ pub(crate) fn checks() -> Vec<Check> {
     );
     t314.basis = BASIS_C.into();
     t314.notes = "Holds (m = 1 on the clipped presets).".into();
+    Check::new(t314, thm_3_14)
+}
+
+/// The check `thm-4.2-v-update`.
+fn thm_4_2_check() -> Check {
     let mut t42 = meta(
         "thm-4.2-v-update",
         "Theorem 4.2, eqs. (4.8)–(4.10) (v-update with fixed σ)",
@@ -851,6 +878,11 @@ pub(crate) fn checks() -> Vec<Check> {
         below 6% of c on these tasks, so a c divided by 2 is not caught by the true J \
         (thm-4.2-closed-form catches it)."
         .into();
+    Check::new(t42, thm_4_2)
+}
+
+/// The check `thm-4.2-closed-form`.
+fn thm_4_2_closed_form_check() -> Check {
     let mut t42c = meta(
         "thm-4.2-closed-form",
         "Theorem 4.2 implementation vs the printed (4.8)–(4.10)",
@@ -871,6 +903,11 @@ pub(crate) fn checks() -> Vec<Check> {
     t42c.cases_quick = 500;
     t42c.false_alarm_rate = "0: closed forms; the tolerance absorbs rounding".into();
     t42c.notes = "Holds.".into();
+    Check::new(t42c, thm_4_2_closed_form)
+}
+
+/// The check `thm-4.3-w-update-thesis`.
+fn thm_4_3_thesis_check() -> Check {
     let mut t43 = meta(
         "thm-4.3-w-update-thesis",
         "Theorem 4.3, eqs. (4.15)–(4.17), thesis form (o(Δw³) neglected)",
@@ -882,6 +919,11 @@ pub(crate) fn checks() -> Vec<Check> {
     t43.notes = "Holds against the true J on the presets even where the thesis form exceeds the \
         rigorous bound (figure 'neglected part'): d is far larger than the true curvature."
         .into();
+    Check::new(t43, thm_4_3_thesis)
+}
+
+/// The check `thm-4.3-w-update-rigorous`.
+fn thm_4_3_rigorous_check() -> Check {
     let mut t43r = meta(
         "thm-4.3-w-update-rigorous",
         "Theorem 4.3, rigorous variant (docs/CONVENTIONS.md §4: remainder at min(σ, σ'), KL direction chosen)",
@@ -894,6 +936,11 @@ pub(crate) fn checks() -> Vec<Check> {
         K_W (docs/CONVENTIONS.md §4, docs/ERRATA.md §27); the power control (closed-form J at \
         γ = 0) shows that the comparison with the exact J sees its penalty divided by 30"
         .into();
+    Check::new(t43r, thm_4_3_rigorous)
+}
+
+/// The check `thm-4.3-neglected-terms`.
+fn thm_4_3_neglected_check() -> Check {
     let mut t43n = meta(
         "thm-4.3-neglected-terms",
         "Theorem 4.3: the neglected o(Δw³) terms",
@@ -917,6 +964,11 @@ pub(crate) fn checks() -> Vec<Check> {
         theory does not decide these steps (the thesis form exceeds the provable bound there, \
         see the figures)"
         .into();
+    Check::new(t43n, thm_4_3_neglected)
+}
+
+/// The check `cor-4.4-surrogate`.
+fn cor_4_4_check() -> Check {
     let mut c44 = meta(
         "cor-4.4-surrogate",
         "Corollary 4.4 (surrogate L as guaranteed improvement)",
@@ -925,6 +977,11 @@ pub(crate) fn checks() -> Vec<Check> {
     );
     c44.basis = BASIS_C.into();
     c44.notes = "Holds (m = 1, so L = C_max^v).".into();
+    Check::new(c44, cor_4_4)
+}
+
+/// The check `app-b-surrogate-gradient`.
+fn surrogate_gradient_check() -> Check {
     let mut gl = meta(
         "app-b-surrogate-gradient",
         "Appendix B (B.1) and ∂_σ∇_vJ = h − (2/σ)∇_vJ: the exact ∇_w L",
@@ -952,6 +1009,11 @@ pub(crate) fn checks() -> Vec<Check> {
         oracle error amplified by 1/h (≈ 1e-8 relative) are below the 1e-5 relative tolerance"
         .into();
     gl.notes = "Holds.".into();
+    Check::new(gl, surrogate_gradient)
+}
+
+/// The check `thm-4.5-w-update-along-l`.
+fn thm_4_5_check() -> Check {
     let mut t45 = meta(
         "thm-4.5-w-update-along-l",
         "Theorem 4.5 and (4.19), thesis form and rigorous variant",
@@ -962,6 +1024,11 @@ pub(crate) fn checks() -> Vec<Check> {
     );
     t45.basis = BASIS_D.into();
     t45.notes = "Holds.".into();
+    Check::new(t45, thm_4_5)
+}
+
+/// The check `eq-4.20-combined-update`.
+fn eq_4_20_check() -> Check {
     let mut e420 = meta(
         "eq-4.20-combined-update",
         "Update (4.20) with the split (4.13)–(4.14)",
@@ -971,19 +1038,7 @@ pub(crate) fn checks() -> Vec<Check> {
     );
     e420.basis = BASIS_D.into();
     e420.notes = "Holds (cases where νC exceeds C_max^w at v^{t+1} are skipped).".into();
-    vec![
-        Check::new(t310, thm_3_10),
-        Check::new(t314, thm_3_14),
-        Check::new(t42, thm_4_2),
-        Check::new(t42c, thm_4_2_closed_form),
-        Check::new(t43, thm_4_3_thesis),
-        Check::new(t43r, thm_4_3_rigorous),
-        Check::new(t43n, thm_4_3_neglected),
-        Check::new(c44, cor_4_4),
-        Check::new(gl, surrogate_gradient),
-        Check::new(t45, thm_4_5),
-        Check::new(e420, eq_4_20),
-    ]
+    Check::new(e420, eq_4_20)
 }
 
 #[cfg(test)]

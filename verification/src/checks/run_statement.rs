@@ -487,42 +487,7 @@ fn evaluate(results: &[CellResult], seeds: u64, iterations: u64) -> Evaluation {
             value: q.to_string(),
         },
     ];
-    let mut kinds: Vec<StatementKind> = Vec::new();
-    for r in results {
-        for k in &r.kinds {
-            if !kinds.contains(k) {
-                kinds.push(*k);
-            }
-        }
-        let first = r.first.as_ref().map_or(String::new(), |(seed, b)| {
-            format!(
-                "; first: seed {seed}, iteration {}, {} short by {}",
-                b.iteration,
-                b.what,
-                fmt_f64(b.shortfall)
-            )
-        });
-        figures.push(Figure {
-            name: format!("{}: broken runs", r.label),
-            value: format!(
-                "{} of {} (tightest slack {}){first}",
-                r.broken,
-                r.runs,
-                fmt_f64(r.tightest)
-            ),
-        });
-    }
-    figures.insert(
-        0,
-        Figure {
-            name: "statement kinds of the runs".into(),
-            value: kinds
-                .iter()
-                .map(|k| kind_name(*k))
-                .collect::<Vec<_>>()
-                .join(", "),
-        },
-    );
+    cell_figures(results, &mut figures);
     let runs: u64 = results.iter().map(|r| r.runs).sum();
     let evals = results.iter().fold((0, 0), |a, r| {
         (a.0 + r.evaluations.0, a.1 + r.evaluations.1)
@@ -564,6 +529,47 @@ fn evaluate(results: &[CellResult], seeds: u64, iterations: u64) -> Evaluation {
         cases: runs,
         figures,
     }
+}
+
+/// Appends the figures of each cell (broken runs, tightest slack, first failure) and puts
+/// first a figure listing the statement kinds the runs recorded.
+fn cell_figures(results: &[CellResult], figures: &mut Vec<Figure>) {
+    let mut kinds: Vec<StatementKind> = Vec::new();
+    for r in results {
+        for k in &r.kinds {
+            if !kinds.contains(k) {
+                kinds.push(*k);
+            }
+        }
+        let first = r.first.as_ref().map_or(String::new(), |(seed, b)| {
+            format!(
+                "; first: seed {seed}, iteration {}, {} short by {}",
+                b.iteration,
+                b.what,
+                fmt_f64(b.shortfall)
+            )
+        });
+        figures.push(Figure {
+            name: format!("{}: broken runs", r.label),
+            value: format!(
+                "{} of {} (tightest slack {}){first}",
+                r.broken,
+                r.runs,
+                fmt_f64(r.tightest)
+            ),
+        });
+    }
+    figures.insert(
+        0,
+        Figure {
+            name: "statement kinds of the runs".into(),
+            value: kinds
+                .iter()
+                .map(|k| kind_name(*k))
+                .collect::<Vec<_>>()
+                .join(", "),
+        },
+    );
 }
 
 fn cells(presets: &[Preset], variants: &[Requirement], optimum_only: bool) -> Vec<Cell> {
@@ -646,11 +652,26 @@ fn judged_cells(
     }
 }
 
+const JUDGE_TEXT: &str = "Each run is judged against exact J at every point: θᵗ⁺½ = (vᵗ⁺¹, wᵗ) and \
+                      θᵗ⁺¹ of every iteration (LV also its target (vᵗ, w_Tᵗ)), for the \
+                      requirement of its variant (MI: J(θᵗ⁺½) ≥ J(θᵗ), J(θᵗ⁺¹) ≥ J(θᵗ⁺½); \
+                      LB-I: J ≥ J(θ⁰); LB-II, LV, ZV: J ≥ J(θ⁰) − B⁰, ZV's deterministic \
+                      target excluded) and every logged guarantee (J(θᵗ⁺½) − J(θᵗ) ≥ gᵥᵗ, \
+                      J(θᵗ⁺¹) − J(θᵗ⁺½) ≥ g_wᵗ); one failure beyond the tolerance breaks the run.";
+const GROUND_TRUTH: &str = "exact J_H (H = 20) of the clipped presets from the dynamic-programming \
+                        oracle of sepg-mdp (J only, cached by the bit patterns of (v, w)); its \
+                        error on differences of J is below 1e-11 (measured against a finer \
+                        oracle in the unit tests), the tolerance is 1e-10";
+
 /// The checks of this module.
 pub(crate) fn checks() -> Vec<Check> {
+    vec![theorem_r_check(), estimated_control_check()]
+}
+
+/// The check `thm-r-run-statement-exact`.
+fn theorem_r_check() -> Check {
     let cells_full = cells(&PRESETS, &VARIANTS, false).len() as u32;
     let cells_quick = cells(&PRESETS, &VARIANTS, true).len() as u32;
-    let control_cells = cells(&PRESETS, &CONTROL_VARIANTS, true).len() as u32;
     let starts_text = format!(
         "starts per preset: the v-optimum of the clipped H = 20 model (lqg: v⁰ = {LQG_V_STAR} at \
          σ⁰ = 2; lqg1d: v⁰ = {LQG1D_V_STAR} at σ⁰ = 1), 0.01 above it at the same σ⁰, and \
@@ -660,110 +681,107 @@ pub(crate) fn checks() -> Vec<Check> {
         abs: J_TOLERANCE,
         rel: 0.0,
     };
-    let judge_text = "Each run is judged against exact J at every point: θᵗ⁺½ = (vᵗ⁺¹, wᵗ) and \
-                      θᵗ⁺¹ of every iteration (LV also its target (vᵗ, w_Tᵗ)), for the \
-                      requirement of its variant (MI: J(θᵗ⁺½) ≥ J(θᵗ), J(θᵗ⁺¹) ≥ J(θᵗ⁺½); \
-                      LB-I: J ≥ J(θ⁰); LB-II, LV, ZV: J ≥ J(θ⁰) − B⁰, ZV's deterministic \
-                      target excluded) and every logged guarantee (J(θᵗ⁺½) − J(θᵗ) ≥ gᵥᵗ, \
-                      J(θᵗ⁺¹) − J(θᵗ⁺½) ≥ g_wᵗ); one failure beyond the tolerance breaks the run.";
-    let ground_truth = "exact J_H (H = 20) of the clipped presets from the dynamic-programming \
-                        oracle of sepg-mdp (J only, cached by the bit patterns of (v, w)); its \
-                        error on differences of J is below 1e-11 (measured against a finer \
-                        oracle in the unit tests), the tolerance is 1e-10";
-    vec![
-        Check::new(
-            CheckMeta {
-                id: "thm-r-run-statement-exact".into(),
-                statement: "Theorem R (a statement over the whole run): with sampled gradients \
+    Check::new(
+        CheckMeta {
+            id: "thm-r-run-statement-exact".into(),
+            statement: "Theorem R (a statement over the whole run): with sampled gradients \
                             and the default options, P(every requirement and every logged \
                             guarantee holds at every point of the run, against exact J) ≥ 1 − δ"
-                    .into(),
-                location: "docs/THEOREMS.md, Statements over a whole run; Table 4.1, \
+                .into(),
+            location: "docs/THEOREMS.md, Statements over a whole run; Table 4.1, \
                            Algorithms 4.1–4.3"
-                    .into(),
-                claim: format!(
-                    "{judge_text} Per cell (preset, variant, start), the number k of broken \
+                .into(),
+            claim: format!(
+                "{JUDGE_TEXT} Per cell (preset, variant, start), the number k of broken \
                      runs among n independent seeds is at most the 1 − 0.05/cells quantile of \
                      Bin(n, δ), δ = {DELTA}."
-                ),
-                ground_truth: ground_truth.into(),
-                sampling: format!(
-                    "MI, LB-I (ν = 0.5), LB-II, LV, ZV on lqg and lqg1d (clipped), sampled \
+            ),
+            ground_truth: GROUND_TRUTH.into(),
+            sampling: format!(
+                "MI, LB-I (ν = 0.5), LB-II, LV, ZV on lqg and lqg1d (clipped), sampled \
                      gradients, N = 100, δ = {DELTA}, B⁰ = 0, the options `sepg run` takes by \
                      default (certified accounting, schedule run, proven widths, the tight \
                      constants for non-positive rewards); {starts_text}. Full: \
                      {cells_full} cells × {} seeds × {} iterations; quick: the optimum starts \
                      only, {cells_quick} cells × {} seeds × {} iterations",
-                    FULL.0, FULL.1, QUICK.0, QUICK.1
-                ),
-                kind: ClaimKind::UpperBound,
-                cases_full: cells_full * FULL.0 as u32,
-                cases_quick: cells_quick * QUICK.0 as u32,
-                tolerance,
-                false_alarm_rate: "at most 5% in all: with a valid statement P(k > q) ≤ \
+                FULL.0, FULL.1, QUICK.0, QUICK.1
+            ),
+            kind: ClaimKind::UpperBound,
+            cases_full: cells_full * FULL.0 as u32,
+            cases_quick: cells_quick * QUICK.0 as u32,
+            tolerance,
+            false_alarm_rate: "at most 5% in all: with a valid statement P(k > q) ≤ \
                                    0.05/cells in each cell (q the 1 − 0.05/cells quantile of \
                                    Bin(n, δ); runs of a cell are independent), Bonferroni over \
                                    the cells"
-                    .into(),
-                expected: Expected::Holds,
-                notes: "The optimum starts are where the oracle's ∂J/∂v vanishes (|∂J/∂v| < \
+                .into(),
+            expected: Expected::Holds,
+            notes: "The optimum starts are where the oracle's ∂J/∂v vanishes (|∂J/∂v| < \
                         1e-12 at both, checked in the unit tests): there every v-step can only \
                         lose, which is where the thesis's bookkeeping breaks (the negative \
                         control thm-r-estimated-bookkeeping-exact). The figures give k per \
                         cell, the tightest slack of any comparison and the first failure, and \
                         the statement kind the runs record (proven or approximate, whatever \
                         the default widths are)."
-                    .into(),
-                basis: "theory: Theorem R of docs/THEOREMS.md (certified accounting, union \
+                .into(),
+            basis: "theory: Theorem R of docs/THEOREMS.md (certified accounting, union \
                         bound over the run); the count per cell is compared with δ, which the \
                         theorem bounds"
-                    .into(),
-            },
-            theorem_r,
-        ),
-        Check::new(
-            CheckMeta {
-                id: "thm-r-estimated-bookkeeping-exact".into(),
-                statement: "Negative control of thm-r-run-statement-exact: the thesis's \
+                .into(),
+        },
+        theorem_r,
+    )
+}
+
+/// The check `thm-r-estimated-bookkeeping-exact`.
+fn estimated_control_check() -> Check {
+    let control_cells = cells(&PRESETS, &CONTROL_VARIANTS, true).len() as u32;
+    let tolerance = Tolerance {
+        abs: J_TOLERANCE,
+        rel: 0.0,
+    };
+    Check::new(
+        CheckMeta {
+            id: "thm-r-estimated-bookkeeping-exact".into(),
+            statement: "Negative control of thm-r-run-statement-exact: the thesis's \
                             bookkeeping (requirements from estimated J, widths at level δ \
                             each; SepgOptions::estimated) does not meet Theorem R's \
                             requirements"
-                    .into(),
-                location: "Sec 4.4.4 (budgets from estimated J); docs/THEOREMS.md, \
+                .into(),
+            location: "Sec 4.4.4 (budgets from estimated J); docs/THEOREMS.md, \
                            Statements over a whole run"
-                    .into(),
-                claim: format!(
-                    "{judge_text} The same judge and binomial test as \
+                .into(),
+            claim: format!(
+                "{JUDGE_TEXT} The same judge and binomial test as \
                      thm-r-run-statement-exact, applied to runs with the thesis's bookkeeping."
-                ),
-                ground_truth: ground_truth.into(),
-                sampling: format!(
-                    "LB-I (ν = 0.5), LB-II, ZV from the v-optimum of lqg (σ⁰ = 2) and lqg1d \
+            ),
+            ground_truth: GROUND_TRUTH.into(),
+            sampling: format!(
+                "LB-I (ν = 0.5), LB-II, ZV from the v-optimum of lqg (σ⁰ = 2) and lqg1d \
                      (σ⁰ = 1), sampled gradients, N = 100, δ = {DELTA}, accounting = \
                      estimated, schedule = iteration. Full: {control_cells} cells × {} seeds × \
                      {} iterations; quick: {} seeds × {} iterations",
-                    CONTROL_FULL.0, CONTROL_FULL.1, CONTROL_QUICK.0, CONTROL_QUICK.1
-                ),
-                kind: ClaimKind::UpperBound,
-                cases_full: control_cells * CONTROL_FULL.0 as u32,
-                cases_quick: control_cells * CONTROL_QUICK.0 as u32,
-                tolerance,
-                false_alarm_rate: "not applicable: the expected outcome is a violation; the \
+                CONTROL_FULL.0, CONTROL_FULL.1, CONTROL_QUICK.0, CONTROL_QUICK.1
+            ),
+            kind: ClaimKind::UpperBound,
+            cases_full: control_cells * CONTROL_FULL.0 as u32,
+            cases_quick: control_cells * CONTROL_QUICK.0 as u32,
+            tolerance,
+            false_alarm_rate: "not applicable: the expected outcome is a violation; the \
                                    test that finds it is the one of thm-r-run-statement-exact"
-                    .into(),
-                expected: Expected::Violated,
-                notes: "Shows that the judge sees real failures: at the optimum any step \
+                .into(),
+            expected: Expected::Violated,
+            notes: "Shows that the judge sees real failures: at the optimum any step \
                         spends a worsening the bookkeeping takes from an optimistic estimate \
                         of J, so LB-I, LB-II and ZV break J ≥ J(θ⁰) (− B⁰) in most seeds."
-                    .into(),
-                basis: "independent computation: exact-J audits of runs with the thesis's \
+                .into(),
+            basis: "independent computation: exact-J audits of runs with the thesis's \
                         bookkeeping from the same starts (issue review: every LB-I, LB-II, ZV \
                         run broke, 3 of 3 seeds per preset)"
-                    .into(),
-            },
-            estimated_control,
-        ),
-    ]
+                .into(),
+        },
+        estimated_control,
+    )
 }
 
 #[cfg(test)]

@@ -11,17 +11,13 @@ use std::fmt::Write as _;
 
 use proptest::prelude::*;
 use sepg_bounds::batch_size;
-use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::high_probability::{HighProbabilityBound, HpForm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_bounds::pirotta::{self, AdaptiveStep};
 use sepg_estimators::{
-    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Kind, Param, SurrogateEstimate,
-    Width, normal_quantile,
+    Baseline, BaselineFit, Estimate, Estimator, GradientSpec, Kind, Param, SurrogateEstimate, Width,
 };
 use sepg_mdp::Batch;
-use sepg_mdp::env::LqgEnv;
-use sepg_mdp::oracle::ExactEval;
 use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::rollout;
@@ -30,208 +26,15 @@ use crate::check::{
     Check, CheckContext, CheckMeta, ClaimKind, Evaluation, Expected, Figure, Outcome, Tolerance,
     fmt_f64,
 };
+use crate::lqg::Setting;
 use crate::lqg::{HORIZON, Preset, Task};
 use crate::search::{Comparison, search};
-use crate::stats::{clopper_pearson_lower, clopper_pearson_upper};
+use crate::stats::{
+    Freq, ZTest, clopper_pearson_lower, clopper_pearson_upper, frequency_outcome, z_outcome,
+};
 
-/// Family-wise false-alarm rate of every statistical check in this module.
-const FAMILY_ALPHA: f64 = 1e-3;
-
-/// A policy on a preset, with its exact values, rollouts and estimators.
-pub(crate) struct Setting {
-    pub(crate) task: Task,
-    env: LqgEnv,
-    policy: GaussianPolicy,
-    pub(crate) v: f64,
-    pub(crate) w: f64,
-    pub(crate) sigma: f64,
-    pub(crate) exact: ExactEval,
-}
-
-impl Setting {
-    pub(crate) fn new(
-        preset: Preset,
-        gamma: f64,
-        sigma: f64,
-        v: f64,
-        clipped: bool,
-    ) -> Option<Self> {
-        let task = if clipped {
-            Task::new(preset, gamma)?
-        } else {
-            Task::unclipped(preset, gamma)?
-        };
-        let env = task.env()?;
-        let w = sigma.ln();
-        let exact = task.eval(v, w)?;
-        Some(Self {
-            policy: GaussianPolicy::scalar(v, w).ok()?,
-            task,
-            env,
-            v,
-            w,
-            sigma,
-            exact,
-        })
-    }
-
-    pub(crate) fn batch(&self, n: usize, seed: u64, index: u64) -> Option<Batch> {
-        rollout(
-            &self.env,
-            &self.policy,
-            n,
-            HORIZON,
-            SeedKey::new(seed, index, 0),
-        )
-        .ok()
-    }
-
-    pub(crate) fn k(&self) -> &TaskConstants {
-        &self.task.k
-    }
-}
-
-/// One binomial test: `violations` out of `trials`, claimed rate at most `allowed`.
-pub(crate) struct Freq {
-    pub(crate) name: String,
-    pub(crate) violations: u64,
-    pub(crate) trials: u64,
-    pub(crate) allowed: f64,
-}
-
-/// Clopper–Pearson test of every [`Freq`] at family-wise level [`FAMILY_ALPHA`] (Bonferroni):
-/// a claim is rejected when the one-sided lower confidence bound on its violation rate exceeds
-/// the allowed rate.
-pub(crate) fn frequency_outcome(tests: &[Freq]) -> Evaluation {
-    let confidence = 1.0 - FAMILY_ALPHA / tests.len().max(1) as f64;
-    let mut figures = Vec::new();
-    let mut worst: Option<(f64, String)> = None;
-    let (mut margin, mut relative) = (f64::INFINITY, f64::INFINITY);
-    let mut trials = 0;
-    for t in tests.iter().filter(|t| t.trials > 0) {
-        trials += t.trials;
-        let rate = t.violations as f64 / t.trials as f64;
-        let (Ok(lo), Ok(hi)) = (
-            clopper_pearson_lower(t.violations, t.trials, confidence),
-            clopper_pearson_upper(t.violations, t.trials, 0.95),
-        ) else {
-            continue;
-        };
-        figures.push(Figure {
-            name: t.name.clone(),
-            value: format!(
-                "{}/{} violations, rate {}, 95% upper bound {}, allowed {}",
-                t.violations,
-                t.trials,
-                fmt_f64(rate),
-                fmt_f64(hi),
-                fmt_f64(t.allowed)
-            ),
-        });
-        if lo > t.allowed {
-            let amount = rate - t.allowed;
-            if worst.as_ref().is_none_or(|(a, _)| amount > *a) {
-                worst = Some((
-                    amount,
-                    format!(
-                        "{}: {}/{} violations (rate {}, one-sided {} lower bound {}) > allowed {}",
-                        t.name,
-                        t.violations,
-                        t.trials,
-                        fmt_f64(rate),
-                        fmt_f64(confidence),
-                        fmt_f64(lo),
-                        fmt_f64(t.allowed)
-                    ),
-                ));
-            }
-        }
-        margin = margin.min(t.allowed - rate);
-        relative = relative.min((t.allowed - rate) / t.allowed);
-    }
-    let outcome = match worst {
-        Some((amount, counterexample)) => Outcome::Violated {
-            counterexample,
-            amount,
-        },
-        None if trials == 0 => Outcome::Inconclusive {
-            reason: "no informative trial".into(),
-        },
-        None => Outcome::HoldsWithMargin {
-            margin,
-            relative_margin: relative,
-        },
-    };
-    Evaluation {
-        outcome,
-        cases: trials,
-        figures,
-    }
-}
-
-/// One z-test of an unbiasedness claim: the mean of `samples` (independent batch estimates)
-/// against the exact value.
-struct ZTest {
-    name: String,
-    samples: Vec<f64>,
-    truth: f64,
-}
-
-fn z_outcome(tests: &[ZTest]) -> Evaluation {
-    let m = tests.len().max(1) as f64;
-    let z_crit = normal_quantile(1.0 - FAMILY_ALPHA / (2.0 * m)).unwrap_or(f64::INFINITY);
-    let mut figures = vec![Figure {
-        name: "critical |z| (two-sided, Bonferroni)".into(),
-        value: fmt_f64(z_crit),
-    }];
-    let mut max_error = 0.0f64;
-    let mut worst: Option<(f64, String)> = None;
-    let mut cases = 0;
-    for t in tests {
-        let n = t.samples.len() as f64;
-        cases += t.samples.len() as u64;
-        let mean = t.samples.iter().sum::<f64>() / n;
-        let var = t.samples.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        let se = (var / n).sqrt();
-        let z = (mean - t.truth) / se;
-        max_error = max_error.max((mean - t.truth).abs());
-        figures.push(Figure {
-            name: t.name.clone(),
-            value: format!(
-                "mean {} ± {} (s.e.), exact {}, z = {}",
-                fmt_f64(mean),
-                fmt_f64(se),
-                fmt_f64(t.truth),
-                fmt_f64(z)
-            ),
-        });
-        let rejected = z.is_nan() || z.abs() > z_crit;
-        if rejected && worst.as_ref().is_none_or(|(a, _)| z.abs() > *a) {
-            worst = Some((
-                z.abs(),
-                format!(
-                    "{}: mean {} vs exact {} (z = {})",
-                    t.name,
-                    fmt_f64(mean),
-                    fmt_f64(t.truth),
-                    fmt_f64(z)
-                ),
-            ));
-        }
-    }
-    let outcome = match worst {
-        Some((z, counterexample)) => Outcome::Violated {
-            counterexample,
-            amount: z - z_crit,
-        },
-        None => Outcome::Holds { max_error },
-    };
-    Evaluation {
-        outcome,
-        cases,
-        figures,
-    }
-}
+/// Family-wise false-alarm rate of every statistical check in this module (Bonferroni across the family).
+pub(crate) const FAMILY_ALPHA: f64 = 1e-3;
 
 /// Trajectories per batch of the sampled checks (the experiments' N).
 pub(crate) const N: usize = 100;
@@ -302,7 +105,7 @@ fn assumption_4_6(ctx: &CheckContext<'_>) -> Evaluation {
             }
         }
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// Batch sizes of the Gaussian coverage check: small, where a wrong width is far from exact.
@@ -322,23 +125,7 @@ fn assumption_4_6_gaussian(ctx: &CheckContext<'_>) -> Evaluation {
     let mut trials_total = 0;
     let mut x = Vec::new();
     for &n in &GAUSSIAN_NS {
-        let mut misses = [0u64; 2];
-        let mut trials = 0u64;
-        for _ in 0..ctx.cases {
-            x.clear();
-            x.extend((0..n).map(|_| 0.5 + 2.0 * sepg_mdp::rng::standard_normal(&mut rng)));
-            let mean = x.iter().sum::<f64>() / n as f64;
-            let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n as f64 - 1.0);
-            trials += 1;
-            for (di, &delta) in deltas.iter().enumerate() {
-                let Ok(eps) = sepg_estimators::width(Width::StudentT, var, n, delta) else {
-                    continue;
-                };
-                if (mean - 0.5).abs() > eps {
-                    misses[di] += 1;
-                }
-            }
-        }
+        let (misses, trials) = gaussian_misses(&mut rng, &mut x, n, ctx.cases, &deltas);
         trials_total += trials;
         for (di, &delta) in deltas.iter().enumerate() {
             let (Ok(lo), Ok(hi)) = (
@@ -393,6 +180,36 @@ fn assumption_4_6_gaussian(ctx: &CheckContext<'_>) -> Evaluation {
         cases: trials_total,
         figures,
     }
+}
+
+/// Draws `cases` batches of `n` independent N(0.5, 2²) samples and counts, for each δ of
+/// `deltas`, the batches whose Student-t interval at level δ misses the mean 0.5; returns the
+/// miss counts and the number of batches.
+fn gaussian_misses(
+    rng: &mut sepg_mdp::rng::TrajRng,
+    x: &mut Vec<f64>,
+    n: usize,
+    cases: u32,
+    deltas: &[f64; 2],
+) -> ([u64; 2], u64) {
+    let mut misses = [0u64; 2];
+    let mut trials = 0u64;
+    for _ in 0..cases {
+        x.clear();
+        x.extend((0..n).map(|_| 0.5 + 2.0 * sepg_mdp::rng::standard_normal(rng)));
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n as f64 - 1.0);
+        trials += 1;
+        for (di, &delta) in deltas.iter().enumerate() {
+            let Ok(eps) = sepg_estimators::width(Width::StudentT, var, n, delta) else {
+                continue;
+            };
+            if (mean - 0.5).abs() > eps {
+                misses[di] += 1;
+            }
+        }
+    }
+    (misses, trials)
 }
 
 /// Which high-probability theorem.
@@ -451,41 +268,14 @@ fn hp_counts(
         ) else {
             continue;
         };
-        let (bound, direction) = match which {
-            Hp::V => (
-                HighProbabilityBound::v_update(s.k(), s.sigma, gv.mean(), cv.eps),
-                gv.mean()[0],
-            ),
-            Hp::WJ => (
-                HighProbabilityBound::w_along_j(s.k(), s.sigma, gw.mean()[0], cw.eps),
-                gw.mean()[0],
-            ),
-            Hp::WL => {
-                let mut sur = SurrogateEstimate::new();
-                if est
-                    .surrogate_gradient_for_task(&batch, GradientSpec::default(), s.k(), &mut sur)
-                    .is_err()
-                {
-                    continue;
-                }
-                let Ok(cl) = sur.grad_w_l().confidence(Width::StudentT, delta) else {
-                    continue;
-                };
-                let gl = sur.grad_w_l().mean()[0];
-                (
-                    HighProbabilityBound::w_along_l(
-                        s.k(),
-                        s.sigma,
-                        gw.mean()[0],
-                        cw.eps,
-                        gl,
-                        cl.eps,
-                    ),
-                    gl,
-                )
-            }
-        };
-        let Ok(Some(bound)) = bound else {
+        let Some((bound, direction)) = hp_bound(
+            s,
+            which,
+            &mut est,
+            &batch,
+            (&gv, &gw),
+            (cv.eps, cw.eps, delta),
+        ) else {
             continue;
         };
         let c_max = bound.c_max();
@@ -521,6 +311,50 @@ fn hp_counts(
         }
     }
     counts
+}
+
+/// The high-probability bound of theorem `which` on one batch, from the batch's gradient
+/// estimates `(∇̂_v J, ∇̂_w J)` and `(ε_v, ε_wJ, δ)`, with the estimated direction of its step;
+/// `None` when an estimate or the bound is unavailable.
+fn hp_bound(
+    s: &Setting,
+    which: Hp,
+    est: &mut Estimator,
+    batch: &Batch,
+    (gv, gw): (&Estimate, &Estimate),
+    (eps_v, eps_w, delta): (f64, f64, f64),
+) -> Option<(HighProbabilityBound, f64)> {
+    let (bound, direction) = match which {
+        Hp::V => (
+            HighProbabilityBound::v_update(s.k(), s.sigma, gv.mean(), eps_v),
+            gv.mean()[0],
+        ),
+        Hp::WJ => (
+            HighProbabilityBound::w_along_j(s.k(), s.sigma, gw.mean()[0], eps_w),
+            gw.mean()[0],
+        ),
+        Hp::WL => {
+            let mut sur = SurrogateEstimate::new();
+            if est
+                .surrogate_gradient_for_task(batch, GradientSpec::default(), s.k(), &mut sur)
+                .is_err()
+            {
+                return None;
+            }
+            let Ok(cl) = sur.grad_w_l().confidence(Width::StudentT, delta) else {
+                return None;
+            };
+            let gl = sur.grad_w_l().mean()[0];
+            (
+                HighProbabilityBound::w_along_l(s.k(), s.sigma, gw.mean()[0], eps_w, gl, cl.eps),
+                gl,
+            )
+        }
+    };
+    let Ok(Some(bound)) = bound else {
+        return None;
+    };
+    Some((bound, direction))
 }
 
 pub(crate) fn hp_settings() -> [(Preset, f64, f64); 2] {
@@ -583,7 +417,10 @@ fn hp_tests(
 }
 
 fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirement) -> Evaluation {
-    let mut eval = frequency_outcome(&hp_tests(ctx, theorems, form, req, ctx.cases, 1.0));
+    let mut eval = frequency_outcome(
+        &hp_tests(ctx, theorems, form, req, ctx.cases, 1.0),
+        FAMILY_ALPHA,
+    );
     if !matches!(eval.outcome, Outcome::HoldsWithMargin { .. }) {
         return eval;
     }
@@ -591,7 +428,10 @@ fn hp_check(ctx: &CheckContext<'_>, theorems: &[Hp], form: HpForm, req: Requirem
     let batches = ctx.cases.min(POWER_BATCHES);
     let mut detected_at = None;
     for scale in POWER_SCALES {
-        let control = frequency_outcome(&hp_tests(ctx, theorems, form, req, batches, scale));
+        let control = frequency_outcome(
+            &hp_tests(ctx, theorems, form, req, batches, scale),
+            FAMILY_ALPHA,
+        );
         if matches!(control.outcome, Outcome::Violated { .. }) {
             detected_at = Some(scale);
             eval.figures.extend(control.figures);
@@ -675,7 +515,7 @@ fn thm_3_12(ctx: &CheckContext<'_>) -> Evaluation {
             allowed: delta,
         });
     }
-    frequency_outcome(&tests)
+    frequency_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// Chebyshev batch sizes (Corollary 3.13): the batch size for ε, δ and the violation count of
@@ -690,7 +530,7 @@ enum Chebyshev {
 fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
     let (gamma, sigma, v, delta) = (0.5, 1.0, -0.3, 0.2);
     let Some(s) = Setting::new(Preset::Lqg, gamma, sigma, v, true) else {
-        return frequency_outcome(&[]);
+        return frequency_outcome(&[], FAMILY_ALPHA);
     };
     let k = *s.k();
     let (eps, kind) = match which {
@@ -711,7 +551,7 @@ fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
         }
     };
     let Ok(n) = n else {
-        return frequency_outcome(&[]);
+        return frequency_outcome(&[], FAMILY_ALPHA);
     };
     let spec = GradientSpec {
         kind,
@@ -733,12 +573,15 @@ fn cor_3_13(ctx: &CheckContext<'_>, which: Chebyshev) -> Evaluation {
             violations += 1;
         }
     }
-    let mut eval = frequency_outcome(&[Freq {
-        name: format!("{which:?}: N = {n} (batches of max(N, 2)), ε = {eps}, δ = {delta}"),
-        violations,
-        trials,
-        allowed: delta,
-    }]);
+    let mut eval = frequency_outcome(
+        &[Freq {
+            name: format!("{which:?}: N = {n} (batches of max(N, 2)), ε = {eps}, δ = {delta}"),
+            violations,
+            trials,
+            allowed: delta,
+        }],
+        FAMILY_ALPHA,
+    );
     eval.figures.push(Figure {
         name: "batch size N from the formula".into(),
         value: n.to_string(),
@@ -858,7 +701,7 @@ fn unbiased(ctx: &CheckContext<'_>) -> Evaluation {
             }
         }
     }
-    z_outcome(&tests)
+    z_outcome(&tests, FAMILY_ALPHA)
 }
 
 /// h(θ) = ∂_σ∇_vJ + (2/σ)∇_vJ from the oracle (Appendix B).
@@ -895,7 +738,7 @@ fn thm_b_1(ctx: &CheckContext<'_>) -> Evaluation {
             truth: exact_h(&s),
         });
     }
-    z_outcome(&tests)
+    z_outcome(&tests, FAMILY_ALPHA)
 }
 
 fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
@@ -929,7 +772,7 @@ fn baseline_b_2(ctx: &CheckContext<'_>) -> Evaluation {
             truth: exact_h(&s),
         });
     }
-    let mut eval = z_outcome(&tests);
+    let mut eval = z_outcome(&tests, FAMILY_ALPHA);
     eval.figures.push(Figure {
         name: "per-trajectory variance with the B.2 baseline / without".into(),
         value: ratios,
@@ -989,10 +832,102 @@ const Z_FAR: &str = "1e-3 family-wise: two-sided z-test of the mean of independe
 estimates (N = 100 each), Bonferroni across components";
 
 /// The checks of this module, in registry order.
-pub(crate) fn checks() -> Vec<Check> {
-    let hp_sampling = "fixed settings lqg (σ = 1, v = −0.1) and lqg1d (σ = 0.5, v = −0.3), \
+/// Settings of the Appendix B checks (Theorem B.1 and the baseline B.2).
+const B_SAMPLING: &str = "lqg (σ = 0.5, v = −0.3) clipped and unclipped, lqg1d (σ = 1, v = −0.6) \
+        clipped, γ = 0.9; independent batches of N = 100 (one per case)";
+
+const HP_SAMPLING: &str = "fixed settings lqg (σ = 1, v = −0.1) and lqg1d (σ = 0.5, v = −0.3), \
         γ = 0.9, N = 100 trajectories per batch, G(PO)MDP with the leave-one-out optimal \
         baseline, t-widths at δ = 0.2; independent batches (one per case)";
+const CHEB_SAMPLING: &str = "lqg (clipped), γ = 0.5, σ = 1, v = −0.3, H = 20, δ = 0.2, no \
+        baseline; independent batches (one per case) of the formula's size N (at least 2)";
+
+pub(crate) fn checks() -> Vec<Check> {
+    vec![
+        thm_3_12_check(),
+        cor_3_13_gpomdp_check(),
+        cor_3_13_reinforce_check(),
+        cor_3_13_reinforce_printed_check(),
+        assumption_4_6_check(),
+        assumption_4_6_gaussian_check(),
+        thm_4_7_check(),
+        thm_4_8_check(),
+        thm_4_9_check(),
+        negative_c_printed_check(),
+        negative_c_sign_aware_check(),
+        summation_check(),
+        unbiased_check(),
+        thm_b_1_check(),
+        baseline_b_2_check(),
+    ]
+}
+
+/// The check `thm-3.12-hp-adaptive-step`.
+fn thm_3_12_check() -> Check {
+    let mut t312 = meta(
+        "thm-3.12-hp-adaptive-step",
+        "Theorem 3.12 (high-probability adaptive step, vertex form)",
+        "Section 3.4.1",
+        "With per-component t-widths, the step α* maximising the printed bound (vertex, \
+         sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
+         probability ≤ 1 − (1 − δ)^m (m = 1).",
+        DP_TRUTH,
+    );
+    t312.sampling = HP_SAMPLING.into();
+    t312.basis = BASIS_HP.into();
+    t312.notes = "Holds (the printed α*, with ‖∇⁻‖₁² in the denominator, is not the vertex: see \
+        ERRATA.md)."
+        .into();
+    Check::new(t312, thm_3_12)
+}
+
+/// The check `cor-3.13-gpomdp-batch-size`.
+fn cor_3_13_gpomdp_check() -> Check {
+    let mut c313g = meta(
+        "cor-3.13-gpomdp-batch-size",
+        "Corollary 3.13, G(PO)MDP/PGT batch size",
+        "Section 3.4.1",
+        "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313g.sampling = CHEB_SAMPLING.into();
+    c313g.notes = "Holds with a large margin (Chebyshev is loose).".into();
+    Check::new(c313g, cor_3_13_gpomdp)
+}
+
+/// The check `cor-3.13-reinforce-batch-size`.
+fn cor_3_13_reinforce_check() -> Check {
+    let mut c313r = meta(
+        "cor-3.13-reinforce-batch-size",
+        "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
+        "Section 3.4.1; Pirotta et al. 2013, Theorem 5.4",
+        "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313r.sampling = CHEB_SAMPLING.into();
+    c313r.notes = "Holds.".into();
+    Check::new(c313r, cor_3_13_reinforce)
+}
+
+/// The check `cor-3.13-reinforce-printed`.
+fn cor_3_13_reinforce_printed_check() -> Check {
+    let mut c313p = meta(
+        "cor-3.13-reinforce-printed",
+        "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
+        "Section 3.4.1",
+        "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
+        "exact ∇_vJ of the clipped preset (DP oracle)",
+    );
+    c313p.sampling = CHEB_SAMPLING.into();
+    c313p.expected = Expected::Violated;
+    c313p.notes = "Violated: the printed count vanishes as H grows (N = 1 here; batches of 2 are \
+        used) and the error exceeds ε far more often than δ. See ERRATA.md."
+        .into();
+    Check::new(c313p, cor_3_13_reinforce_printed)
+}
+
+/// The check `assumption-4.6-t-coverage`.
+fn assumption_4_6_check() -> Check {
     let mut a46 = meta(
         "assumption-4.6-t-coverage",
         "Assumption 4.6 with the t-based widths of Section 4.5",
@@ -1019,6 +954,11 @@ pub(crate) fn checks() -> Vec<Check> {
         not give its size. The width itself is checked against theory by \
         assumption-4.6-t-coverage-gaussian"
         .into();
+    Check::new(a46, assumption_4_6)
+}
+
+/// The check `assumption-4.6-t-coverage-gaussian`.
+fn assumption_4_6_gaussian_check() -> Check {
     let mut a46g = meta(
         "assumption-4.6-t-coverage-gaussian",
         "Assumption 4.6 with the t-based widths of Section 4.5, on Gaussian samples",
@@ -1041,6 +981,11 @@ pub(crate) fn checks() -> Vec<Check> {
         N − 1: miss rate ≈ 0.10 instead of 0.05 at N = 3) or the wrong level fails."
         .into();
     a46g.basis = "theory: Student's theorem (exact coverage 1 − δ for Gaussian samples)".into();
+    Check::new(a46g, assumption_4_6_gaussian)
+}
+
+/// The check `thm-4.7-hp-v-update`.
+fn thm_4_7_check() -> Check {
     let mut t47 = meta(
         "thm-4.7-hp-v-update",
         "Theorem 4.7, eqs. (4.24)–(4.26) (sign-aware form, docs/CONVENTIONS.md §4 vertex)",
@@ -1049,9 +994,14 @@ pub(crate) fn checks() -> Vec<Check> {
          step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)^m (m = 1).",
         DP_TRUTH,
     );
-    t47.sampling = hp_sampling.into();
+    t47.sampling = HP_SAMPLING.into();
     t47.basis = BASIS_HP.into();
     t47.notes = "Holds.".into();
+    Check::new(t47, thm_4_7)
+}
+
+/// The check `thm-4.8-hp-w-update`.
+fn thm_4_8_check() -> Check {
     let mut t48 = meta(
         "thm-4.8-hp-w-update",
         "Theorem 4.8, eqs. (4.27)–(4.29)",
@@ -1060,9 +1010,14 @@ pub(crate) fn checks() -> Vec<Check> {
          J(θ′) − J(θ) ≥ C except with probability ≤ δ.",
         DP_TRUTH,
     );
-    t48.sampling = hp_sampling.into();
+    t48.sampling = HP_SAMPLING.into();
     t48.basis = BASIS_HP.into();
     t48.notes = "Holds.".into();
+    Check::new(t48, thm_4_8)
+}
+
+/// The check `thm-4.9-hp-w-along-l`.
+fn thm_4_9_check() -> Check {
     let mut t49 = meta(
         "thm-4.9-hp-w-along-l",
         "Theorem 4.9, eq. (4.30)",
@@ -1071,9 +1026,14 @@ pub(crate) fn checks() -> Vec<Check> {
          largest step for C = 0 realise J(θ′) − J(θ) ≥ C except with probability ≤ 1 − (1 − δ)².",
         DP_TRUTH,
     );
-    t49.sampling = hp_sampling.into();
+    t49.sampling = HP_SAMPLING.into();
     t49.basis = BASIS_HP.into();
     t49.notes = "Holds.".into();
+    Check::new(t49, thm_4_9)
+}
+
+/// The check `thm-4.7-4.9-negative-c-printed`.
+fn negative_c_printed_check() -> Check {
     let mut neg_p = meta(
         "thm-4.7-4.9-negative-c-printed",
         "Theorems 4.7–4.9 for C < 0, intervals (4.26), (4.29), (4.30) as printed",
@@ -1083,13 +1043,18 @@ pub(crate) fn checks() -> Vec<Check> {
          ≤ 1 − (1 − δ)^m.",
         DP_TRUTH,
     );
-    neg_p.sampling = hp_sampling.into();
+    neg_p.sampling = HP_SAMPLING.into();
     neg_p.expected = Expected::Violated;
     neg_p.notes = "Violated: on the side opposite to the estimate the valid linear term is \
         −|x|(‖∇̂‖⁺)², not the printed −|x|(‖∇̂‖⁻)², so the printed end point realises less than C \
         whenever the true gradient is larger than the lower-corrected estimate (most batches). \
         See ERRATA.md; sepg uses the sign-aware interval (thm-4.7-4.9-negative-c-sign-aware)."
         .into();
+    Check::new(neg_p, negative_c_printed)
+}
+
+/// The check `thm-4.7-4.9-negative-c-sign-aware`.
+fn negative_c_sign_aware_check() -> Check {
     let mut neg_s = meta(
         "thm-4.7-4.9-negative-c-sign-aware",
         "Theorems 4.7–4.9 for C < 0 with the sign-aware interval (docs/CONVENTIONS.md §4)",
@@ -1097,55 +1062,14 @@ pub(crate) fn checks() -> Vec<Check> {
         "Same as thm-4.7-4.9-negative-c-printed with the sign-aware interval.",
         DP_TRUTH,
     );
-    neg_s.sampling = hp_sampling.into();
+    neg_s.sampling = HP_SAMPLING.into();
     neg_s.basis = BASIS_HP.into();
     neg_s.notes = "Holds.".into();
-    let mut t312 = meta(
-        "thm-3.12-hp-adaptive-step",
-        "Theorem 3.12 (high-probability adaptive step, vertex form)",
-        "Section 3.4.1",
-        "With per-component t-widths, the step α* maximising the printed bound (vertex, \
-         sepg_bounds::pirotta::hp_optimal_step) improves J by at least its guarantee except with \
-         probability ≤ 1 − (1 − δ)^m (m = 1).",
-        DP_TRUTH,
-    );
-    t312.sampling = hp_sampling.into();
-    t312.basis = BASIS_HP.into();
-    t312.notes = "Holds (the printed α*, with ‖∇⁻‖₁² in the denominator, is not the vertex: see \
-        ERRATA.md)."
-        .into();
-    let cheb_sampling = "lqg (clipped), γ = 0.5, σ = 1, v = −0.3, H = 20, δ = 0.2, no \
-        baseline; independent batches (one per case) of the formula's size N (at least 2)";
-    let mut c313g = meta(
-        "cor-3.13-gpomdp-batch-size",
-        "Corollary 3.13, G(PO)MDP/PGT batch size",
-        "Section 3.4.1",
-        "With N from the G(PO)MDP formula for ε = 1.5, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313g.sampling = cheb_sampling.into();
-    c313g.notes = "Holds with a large margin (Chebyshev is loose).".into();
-    let mut c313r = meta(
-        "cor-3.13-reinforce-batch-size",
-        "Corollary 3.13, REINFORCE batch size as in the source (H(1−γ^H)²/(1−γ)²)",
-        "Section 3.4.1; Pirotta et al. 2013, Theorem 5.4",
-        "With N from the corrected REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313r.sampling = cheb_sampling.into();
-    c313r.notes = "Holds.".into();
-    let mut c313p = meta(
-        "cor-3.13-reinforce-printed",
-        "Corollary 3.13, REINFORCE batch size as printed (H(γ^H)²/(δε²σ²(1−δ)²))",
-        "Section 3.4.1",
-        "With N from the printed REINFORCE formula for ε = 4, P(|∇̂ − ∇| > ε) ≤ δ.",
-        "exact ∇_vJ of the clipped preset (DP oracle)",
-    );
-    c313p.sampling = cheb_sampling.into();
-    c313p.expected = Expected::Violated;
-    c313p.notes = "Violated: the printed count vanishes as H grows (N = 1 here; batches of 2 are \
-        used) and the error exceeds ε far more often than δ. See ERRATA.md."
-        .into();
+    Check::new(neg_s, negative_c_sign_aware)
+}
+
+/// The check `summation-theorem-pgt-gpomdp`.
+fn summation_check() -> Check {
     let mut sum = meta(
         "summation-theorem-pgt-gpomdp",
         "Summation theorem: PGT = G(PO)MDP (Section 2.3.1, used in Section 3.4.1)",
@@ -1167,6 +1091,11 @@ pub(crate) fn checks() -> Vec<Check> {
     sum.cases_quick = 100;
     sum.false_alarm_rate = "0: deterministic; rounding of 20-term sums is ≈ 1e-15 relative".into();
     sum.notes = "Holds.".into();
+    Check::new(sum, summation)
+}
+
+/// The check `reinforce-gpomdp-unbiased`.
+fn unbiased_check() -> Check {
     let mut unb = meta(
         "reinforce-gpomdp-unbiased",
         "REINFORCE (2.1), G(PO)MDP and PGT with baselines are unbiased",
@@ -1181,6 +1110,11 @@ pub(crate) fn checks() -> Vec<Check> {
         .into();
     unb.false_alarm_rate = Z_FAR.into();
     unb.notes = "Holds.".into();
+    Check::new(unb, unbiased)
+}
+
+/// The check `thm-b.1-h-unbiased`.
+fn thm_b_1_check() -> Check {
     let mut b1 = meta(
         "thm-b.1-h-unbiased",
         "Theorem B.1: ĥ of (B.3) is unbiased for h(θ)",
@@ -1189,11 +1123,14 @@ pub(crate) fn checks() -> Vec<Check> {
         "exact ∇_vJ and ∂_σ∇_vJ: DP oracle (clipped) and closed form (unclipped)",
     );
     b1.kind = ClaimKind::Equality;
-    b1.sampling = "lqg (σ = 0.5, v = −0.3) clipped and unclipped, lqg1d (σ = 1, v = −0.6) \
-        clipped, γ = 0.9; independent batches of N = 100 (one per case)"
-        .into();
+    b1.sampling = B_SAMPLING.into();
     b1.false_alarm_rate = Z_FAR.into();
     b1.notes = "Holds.".into();
+    Check::new(b1, thm_b_1)
+}
+
+/// The check `app-b.2-baseline`.
+fn baseline_b_2_check() -> Check {
     let mut b2 = meta(
         "app-b.2-baseline",
         "Appendix B.2: the baseline b_t = b̃_t(G_t + H_t)/(G_tH_t) keeps ĥ unbiased and reduces \
@@ -1204,26 +1141,10 @@ pub(crate) fn checks() -> Vec<Check> {
         "exact h(θ) as in thm-b.1-h-unbiased; pooled sample variances",
     );
     b2.kind = ClaimKind::Equality;
-    b2.sampling = b1.sampling.clone();
+    b2.sampling = B_SAMPLING.into();
     b2.false_alarm_rate = Z_FAR.into();
     b2.notes = "Holds.".into();
-    vec![
-        Check::new(t312, thm_3_12),
-        Check::new(c313g, cor_3_13_gpomdp),
-        Check::new(c313r, cor_3_13_reinforce),
-        Check::new(c313p, cor_3_13_reinforce_printed),
-        Check::new(a46, assumption_4_6),
-        Check::new(a46g, assumption_4_6_gaussian),
-        Check::new(t47, thm_4_7),
-        Check::new(t48, thm_4_8),
-        Check::new(t49, thm_4_9),
-        Check::new(neg_p, negative_c_printed),
-        Check::new(neg_s, negative_c_sign_aware),
-        Check::new(sum, summation),
-        Check::new(unb, unbiased),
-        Check::new(b1, thm_b_1),
-        Check::new(b2, baseline_b_2),
-    ]
+    Check::new(b2, baseline_b_2)
 }
 
 #[cfg(test)]
@@ -1264,7 +1185,10 @@ mod tests {
     }
 
     fn rejected(tests: &[Freq]) -> bool {
-        matches!(frequency_outcome(tests).outcome, Outcome::Violated { .. })
+        matches!(
+            frequency_outcome(tests, FAMILY_ALPHA).outcome,
+            Outcome::Violated { .. }
+        )
     }
 
     #[test]

@@ -4,21 +4,14 @@
 use approx::relative_eq;
 use sepg_bounds::constants::TaskConstants;
 use sepg_bounds::outcome::{SafeInterval, StepOutcome};
+pub use sepg_testkit::close;
+use sepg_testkit::simpson;
 
 /// c(σ) of Theorem 3.14 evaluated straight from the printed formula.
 pub fn c_ref(k: &TaskConstants, sigma: f64) -> f64 {
     let (g, r, m, a) = (k.gamma(), k.r_max(), k.m_phi(), k.action_volume());
     r * m * m / ((1.0 - g).powi(2) * sigma.powi(2))
         * (a / ((2.0 * std::f64::consts::PI).sqrt() * sigma) + g / (2.0 * (1.0 - g)))
-}
-
-/// ∫ f over [lo, hi] by composite Simpson with n (even) panels.
-fn simpson(f: impl Fn(f64) -> f64, lo: f64, hi: f64, n: usize) -> f64 {
-    let h = (hi - lo) / n as f64;
-    let inner: f64 = (1..n)
-        .map(|i| f(lo + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
-        .sum();
-    (f(lo) + inner + f(hi)) * h / 3.0
 }
 
 /// ∫_ℝ |p(z)| φ(z) dz by Simpson on [0, 40] (doubled: p is even), split at the given positive
@@ -92,12 +85,6 @@ pub fn golden_max(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
-}
-
-/// Relative closeness with an absolute floor given by `scale`:
-/// |a − b| ≤ rel · max(|a|, |b|, scale).
-pub fn close(a: f64, b: f64, rel: f64, scale: f64) -> bool {
-    approx::relative_eq!(a, b, epsilon = rel * scale, max_relative = rel)
 }
 
 /// A few task-constant sets used across the tests (the `lqg`, `lqg1d` and Mountain Car

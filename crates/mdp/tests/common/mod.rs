@@ -4,13 +4,7 @@ use nalgebra::{DMatrix, DVector};
 use sepg_mdp::env::LqgEnv;
 use sepg_mdp::lqg_model::{BoxBounds, LqgModel};
 
-/// A pool of `threads` worker threads, to run the same rollout with different thread counts.
-pub fn pool(threads: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool")
-}
+pub use sepg_testkit::pool;
 
 /// A clipped two-dimensional LQG with noise (the generic kernel): state box `[−3, 3]²`,
 /// action box `[−1, 1]²`, initial states in `[−2, 2]²`, noise standard deviations (0.1, 0.05).

@@ -426,264 +426,339 @@ const GT_EXACT: &str = "exact policy evaluation by LU solves of (I − γP_π) V
 /// The Chapter 3 checks, in registry order.
 pub(crate) fn checks() -> Vec<Check> {
     vec![
-        Check::new(
-            with(
-                meta(
-                    "thm-3.1-cpi-bound",
-                    "Theorem 3.1 (Kakade & Langford CPI bound)",
-                    "Section 3.2, eqs. (3.2)–(3.4)",
-                    "For π' = (1−α)π + απ̄ with π̄ greedy w.r.t. Q^π and every α ∈ [0,1]: \
+        thm_3_1_check(),
+        thm_3_2_check(),
+        thm_3_2_nonneg_check(),
+        thm_3_3_check(),
+        thm_3_4_check(),
+        thm_3_4_tight_check(),
+        thm_3_5_check(),
+        thm_3_6_sup_check(),
+        thm_3_6_abs_check(),
+        thm_3_6_nonneg_check(),
+        thm_3_7_check(),
+        thm_3_8_sup_check(),
+        thm_3_8_abs_check(),
+        lemma_3_15_check(),
+        thm_3_16_check(),
+    ]
+}
+
+/// The check `thm-3.1-cpi-bound`.
+fn thm_3_1_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.1-cpi-bound",
+                "Theorem 3.1 (Kakade & Langford CPI bound)",
+                "Section 3.2, eqs. (3.2)–(3.4)",
+                "For π' = (1−α)π + απ̄ with π̄ greedy w.r.t. Q^π and every α ∈ [0,1]: \
                      J(π') − J(π) ≥ α/(1−γ)·(𝔸 − 2αγε/(1−γ(1−α))), 𝔸 = Σ_s d^π(s) Σ_a π̄(a|s) A^π(s,a) \
                      with the normalised d, ε = max_s |Σ_a π̄(a|s) A^π(s,a)| (printed form).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "The printed form is scale-consistent with the normalised d (both sides are \
-                 homogeneous of degree one in the rewards) and holds.",
+                GT_EXACT,
             ),
-            thm_3_1,
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "The printed form is scale-consistent with the normalised d (both sides are \
+                 homogeneous of degree one in the rewards) and holds.",
         ),
-        Check::new(
-            rare(with(
-                meta(
-                    "thm-3.2-cpi-step",
-                    "Theorem 3.2 (CPI step α* and guarantee)",
-                    "Section 3.2, eqs. (3.5)–(3.6)",
-                    "With R = max|R(s,a)|, rewards in [−R, R] and α = min(α*, 1), \
+        thm_3_1,
+    )
+}
+
+/// The check `thm-3.2-cpi-step`.
+fn thm_3_2_check() -> Check {
+    Check::new(
+        rare(with(
+            meta(
+                "thm-3.2-cpi-step",
+                "Theorem 3.2 (CPI step α* and guarantee)",
+                "Section 3.2, eqs. (3.5)–(3.6)",
+                "With R = max|R(s,a)|, rewards in [−R, R] and α = min(α*, 1), \
                      α* = (1−γ)𝔸/(4R): J(π') − J(π) ≥ 𝔸²/(8R) (printed form).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Violated,
-                "Printed constants mix Kakade & Langford's normalised values ((1−γ)-scaled V, \
+                GT_EXACT,
+            ),
+            ClaimKind::LowerBound,
+            Expected::Violated,
+            "Printed constants mix Kakade & Langford's normalised values ((1−γ)-scaled V, \
                  rewards in [0, R]) with the thesis's unnormalised J. In the thesis's units the \
                  derivation from (3.2) with ε ≤ R_span/(1−γ) gives α* = (1−γ)²𝔸/(4R_span) and \
                  J(π') − J(π) ≥ (1−γ)𝔸²/(8R_span), R_span the reward range (2R for rewards \
                  in [−R, R]).",
-            )),
-            thm_3_2,
-        ),
-        Check::new(
-            rare(with(
-                meta(
-                    "thm-3.2-cpi-step-nonneg-rewards",
-                    "Theorem 3.2 (CPI step α* and guarantee), rewards in [0, R]",
-                    "Section 3.2, eqs. (3.5)–(3.6)",
-                    "Same as thm-3.2-cpi-step with rewards in [0, R] (Kakade & Langford's \
+        )),
+        thm_3_2,
+    )
+}
+
+/// The check `thm-3.2-cpi-step-nonneg-rewards`.
+fn thm_3_2_nonneg_check() -> Check {
+    Check::new(
+        rare(with(
+            meta(
+                "thm-3.2-cpi-step-nonneg-rewards",
+                "Theorem 3.2 (CPI step α* and guarantee), rewards in [0, R]",
+                "Section 3.2, eqs. (3.5)–(3.6)",
+                "Same as thm-3.2-cpi-step with rewards in [0, R] (Kakade & Langford's \
                      convention): J(π') − J(π) ≥ 𝔸²/(8R) at α = min((1−γ)𝔸/(4R), 1).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Violated,
-                "Non-negative rewards do not rescue the printed form: the missing factors are \
-                 powers of (1−γ) from the normalisation of values, not the reward sign.",
-            )),
-            thm_3_2_nonneg,
-        ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.3-performance-difference",
-                    "Theorem 3.3 (performance difference lemma)",
-                    "Section 3.2, eq. (3.7)",
-                    "For any π, π̃: J(π̃) − J(π) = 1/(1−γ) Σ_s d^{π̃}(s) Σ_a π̃(a|s) A^π(s,a) \
-                     (equality, normalised d).",
-                    GT_EXACT,
-                ),
-                ClaimKind::Equality,
-                Expected::Holds,
-                "Exact identity.",
+                GT_EXACT,
             ),
-            thm_3_3,
+            ClaimKind::LowerBound,
+            Expected::Violated,
+            "Non-negative rewards do not rescue the printed form: the missing factors are \
+                 powers of (1−γ) from the normalisation of values, not the reward sign.",
+        )),
+        thm_3_2_nonneg,
+    )
+}
+
+/// The check `thm-3.3-performance-difference`.
+fn thm_3_3_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.3-performance-difference",
+                "Theorem 3.3 (performance difference lemma)",
+                "Section 3.2, eq. (3.7)",
+                "For any π, π̃: J(π̃) − J(π) = 1/(1−γ) Σ_s d^{π̃}(s) Σ_a π̃(a|s) A^π(s,a) \
+                     (equality, normalised d).",
+                GT_EXACT,
+            ),
+            ClaimKind::Equality,
+            Expected::Holds,
+            "Exact identity.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.4-state-distribution",
-                    "Theorem 3.4 (future-state distribution bound)",
-                    "Section 3.3, eqs. (3.8)–(3.9)",
-                    "‖d^{π'} − d^π‖₁ ≤ γ/(1−γ)² · D_∞^{π,π'}, D_∞ = max_s ‖π'(·|s) − π(·|s)‖₁ \
+        thm_3_3,
+    )
+}
+
+/// The check `thm-3.4-state-distribution`.
+fn thm_3_4_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.4-state-distribution",
+                "Theorem 3.4 (future-state distribution bound)",
+                "Section 3.3, eqs. (3.8)–(3.9)",
+                "‖d^{π'} − d^π‖₁ ≤ γ/(1−γ)² · D_∞^{π,π'}, D_∞ = max_s ‖π'(·|s) − π(·|s)‖₁ \
                      (printed form, normalised d).",
-                    GT_EXACT,
-                ),
-                ClaimKind::UpperBound,
-                Expected::Holds,
-                "Holds, as printed (no error). For the normalised d of Definition 2.5 the \
+                GT_EXACT,
+            ),
+            ClaimKind::UpperBound,
+            Expected::Holds,
+            "Holds, as printed (no error). For the normalised d of Definition 2.5 the \
                  sharper γ/(1−γ) also holds (thm-3.4-normalised-form); the printed γ/(1−γ)² is \
                  Pirotta et al.'s constant, larger, hence also valid.",
-            ),
-            thm_3_4,
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.4-normalised-form",
-                    "Theorem 3.4, normalised restatement",
-                    "Section 3.3, eq. (3.8) with the normalisation of Definition 2.5",
-                    "‖d^{π'} − d^π‖₁ ≤ γ/(1−γ) · D_∞^{π,π'} for the normalised d \
+        thm_3_4,
+    )
+}
+
+/// The check `thm-3.4-normalised-form`.
+fn thm_3_4_tight_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.4-normalised-form",
+                "Theorem 3.4, normalised restatement",
+                "Section 3.3, eq. (3.8) with the normalisation of Definition 2.5",
+                "‖d^{π'} − d^π‖₁ ≤ γ/(1−γ) · D_∞^{π,π'} for the normalised d \
                      (from (d' − d)ᵀ = γ dᵀ(P_{π'} − P_π)(I − γP_{π'})^{-1}).",
-                    GT_EXACT,
-                ),
-                ClaimKind::UpperBound,
-                Expected::Holds,
-                "The correct constant for the normalised distribution used throughout the thesis.",
+                GT_EXACT,
             ),
-            thm_3_4_tight,
+            ClaimKind::UpperBound,
+            Expected::Holds,
+            "The correct constant for the normalised distribution used throughout the thesis.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.5-pirotta-advantage-bound",
-                    "Theorem 3.5 (Pirotta et al., bound with a baseline policy)",
-                    "Section 3.3, eqs. (3.10)–(3.11)",
-                    "For any π, π', π_b: J(π') − J(π) ≥ Σ_s d^{π_b}(s) A^{π'}_π(s)/(1−γ) − \
+        thm_3_4_tight,
+    )
+}
+
+/// The check `thm-3.5-pirotta-advantage-bound`.
+fn thm_3_5_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.5-pirotta-advantage-bound",
+                "Theorem 3.5 (Pirotta et al., bound with a baseline policy)",
+                "Section 3.3, eqs. (3.10)–(3.11)",
+                "For any π, π', π_b: J(π') − J(π) ≥ Σ_s d^{π_b}(s) A^{π'}_π(s)/(1−γ) − \
                      γ/(1−γ)² · D_∞^{π_b,π'} · ΔA^{π'}_π / 2, ΔA = max_s A^{π'}_π(s) − min_s A^{π'}_π(s).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds as printed (the normalised d and the 1/(1−γ)² constant are consistent \
+                GT_EXACT,
+            ),
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds as printed (the normalised d and the 1/(1−γ)² constant are consistent \
                  here because the first term carries 1/(1−γ)).",
-            ),
-            thm_3_5,
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.6-q-bound-sup-q",
-                    "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup Q as printed",
-                    "Section 3.3, eq. (3.12)",
-                    "J(π') − J(π) ≥ 𝔸^{π'}_{π,μ}/(1−γ) − γ/(1−γ)² · (D_∞^{π,π'})² · ‖Q^π‖_∞/2 \
+        thm_3_5,
+    )
+}
+
+/// The check `thm-3.6-q-bound-sup-q`.
+fn thm_3_6_sup_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.6-q-bound-sup-q",
+                "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup Q as printed",
+                "Section 3.3, eq. (3.12)",
+                "J(π') − J(π) ≥ 𝔸^{π'}_{π,μ}/(1−γ) − γ/(1−γ)² · (D_∞^{π,π'})² · ‖Q^π‖_∞/2 \
                      with ‖Q^π‖_∞ read as sup_{s,a} Q^π(s,a) (no absolute value), signed rewards.",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Violated,
-                "With negative rewards sup Q < 0 turns the penalty into a bonus; the printed \
-                 definition needs an absolute value.",
+                GT_EXACT,
             ),
-            thm_3_6_sup,
+            ClaimKind::LowerBound,
+            Expected::Violated,
+            "With negative rewards sup Q < 0 turns the penalty into a bonus; the printed \
+                 definition needs an absolute value.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.6-q-bound-abs-q",
-                    "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup |Q|",
-                    "Section 3.3, eq. (3.12)",
-                    "Same bound with ‖Q^π‖_∞ = sup_{s,a} |Q^π(s,a)|, signed rewards.",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds on every MDP tried. Note the rigorous derivation from Theorem 3.5 with \
+        thm_3_6_sup,
+    )
+}
+
+/// The check `thm-3.6-q-bound-abs-q`.
+fn thm_3_6_abs_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.6-q-bound-abs-q",
+                "Theorem 3.6 (Pirotta et al., Q-based bound), ‖Q‖_∞ = sup |Q|",
+                "Section 3.3, eq. (3.12)",
+                "Same bound with ‖Q^π‖_∞ = sup_{s,a} |Q^π(s,a)|, signed rewards.",
+                GT_EXACT,
+            ),
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds on every MDP tried. Note the rigorous derivation from Theorem 3.5 with \
                  signed rewards only gives ΔA ≤ 2 D_∞ ‖Q‖_∞ (penalty without the 1/2); the 1/2 is \
                  guaranteed for Q ≥ 0.",
-            ),
-            thm_3_6_abs,
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.6-q-bound-nonneg-rewards",
-                    "Theorem 3.6 (Pirotta et al., Q-based bound), rewards in [0, 1]",
-                    "Section 3.3, eq. (3.12)",
-                    "Same bound with rewards in [0, 1], where sup Q = sup |Q| (the setting of \
+        thm_3_6_abs,
+    )
+}
+
+/// The check `thm-3.6-q-bound-nonneg-rewards`.
+fn thm_3_6_nonneg_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.6-q-bound-nonneg-rewards",
+                "Theorem 3.6 (Pirotta et al., Q-based bound), rewards in [0, 1]",
+                "Section 3.3, eq. (3.12)",
+                "Same bound with rewards in [0, 1], where sup Q = sup |Q| (the setting of \
                      Pirotta et al.).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds: with Q ≥ 0 the per-state spread of Q is at most ‖Q‖_∞.",
+                GT_EXACT,
             ),
-            thm_3_6_nonneg,
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds: with Q ≥ 0 the per-state spread of Q is at most ‖Q‖_∞.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.7-uspi",
-                    "Theorem 3.7 (USPI step size and guarantee)",
-                    "Section 3.3, Theorem 3.7 and eq. (3.13)",
-                    "π' = (1−α)π + απ̄, α = min(α*, 1), α* = (1−γ)𝔸/(γ D_∞^{π,π̄} ΔA^{π̄}_π): \
+        thm_3_6_nonneg,
+    )
+}
+
+/// The check `thm-3.7-uspi`.
+fn thm_3_7_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.7-uspi",
+                "Theorem 3.7 (USPI step size and guarantee)",
+                "Section 3.3, Theorem 3.7 and eq. (3.13)",
+                "π' = (1−α)π + απ̄, α = min(α*, 1), α* = (1−γ)𝔸/(γ D_∞^{π,π̄} ΔA^{π̄}_π): \
                      if α* ≤ 1, J(π') − J(π) ≥ 𝔸²/(2γ D_∞ ΔA); otherwise the bound (3.13) with \
                      π' = π̄ (𝔸, D_∞, ΔA all taken w.r.t. the greedy π̄).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds with the normalised d: the (1−γ) in α* is exactly the factor the \
+                GT_EXACT,
+            ),
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds with the normalised d: the (1−γ) in α* is exactly the factor the \
                  thesis's footnote on normalisation refers to. Printed typos: 'update rule 3.2' \
                  means (3.1); α* and the guarantee's numerator are written with π' where π̄ is \
                  meant (the π' reading gives a weaker, also valid, guarantee).",
-            ),
-            thm_3_7,
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.8-q-bound-sup-q-costs",
-                    "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup Q",
-                    "Section 3.4, Theorem 3.8",
-                    "For a small step π' = (1−0.1α)π + 0.1απ₂ and rewards in [−1, 0] (costs, as in \
+        thm_3_7,
+    )
+}
+
+/// The check `thm-3.8-q-bound-sup-q-costs`.
+fn thm_3_8_sup_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.8-q-bound-sup-q-costs",
+                "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup Q",
+                "Section 3.4, Theorem 3.8",
+                "For a small step π' = (1−0.1α)π + 0.1απ₂ and rewards in [−1, 0] (costs, as in \
                      the LQG): J(π') − J(π) ≥ 1/(1−γ) Σ_s d^π(s) A^{π'}_π(s) − γ/(2(1−γ)²) \
                      ‖π' − π‖²_∞ ‖Q^π‖_∞, ‖Q‖_∞ = sup Q as printed.",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Violated,
-                "With costs, sup Q ≤ 0 so the printed penalty has the wrong sign; the absolute \
+                GT_EXACT,
+            ),
+            ClaimKind::LowerBound,
+            Expected::Violated,
+            "With costs, sup Q ≤ 0 so the printed penalty has the wrong sign; the absolute \
                  value is needed (see thm-3.8-q-bound-abs-q).",
-            ),
-            thm_3_8_sup,
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.8-q-bound-abs-q",
-                    "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup |Q|",
-                    "Section 3.4, Theorem 3.8",
-                    "Small steps π' = (1−0.1α)π + 0.1απ₂, signed rewards, ‖Q‖_∞ = sup |Q|.",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds for small policy steps with the absolute-value reading.",
+        thm_3_8_sup,
+    )
+}
+
+/// The check `thm-3.8-q-bound-abs-q`.
+fn thm_3_8_abs_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.8-q-bound-abs-q",
+                "Theorem 3.8 (continuous version of Pirotta's bound) on finite MDPs, sup |Q|",
+                "Section 3.4, Theorem 3.8",
+                "Small steps π' = (1−0.1α)π + 0.1απ₂, signed rewards, ‖Q‖_∞ = sup |Q|.",
+                GT_EXACT,
             ),
-            thm_3_8_abs,
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds for small policy steps with the absolute-value reading.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "lemma-3.15-trajectory-form",
-                    "Lemma 3.15 (performance of π̃ through the advantage of π)",
-                    "Section 3.6, Lemma 3.15",
-                    "J(π̃) = J(π) + E_{τ∼π̃}[Σ_t γ^t A_π(s_t, a_t)] = J(π) + 1/(1−γ) Σ_s d^{π̃}(s) \
+        thm_3_8_abs,
+    )
+}
+
+/// The check `lemma-3.15-trajectory-form`.
+fn lemma_3_15_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "lemma-3.15-trajectory-form",
+                "Lemma 3.15 (performance of π̃ through the advantage of π)",
+                "Section 3.6, Lemma 3.15",
+                "J(π̃) = J(π) + E_{τ∼π̃}[Σ_t γ^t A_π(s_t, a_t)] = J(π) + 1/(1−γ) Σ_s d^{π̃}(s) \
                      Σ_a π̃(a|s) A_π(s,a) (both equalities).",
-                    "exact evaluation; the trajectory form by propagating the state \
+                "exact evaluation; the trajectory form by propagating the state \
                      distribution of π̃ step by step until γ^t < 1e-18 (no linear solve)",
-                ),
-                ClaimKind::Equality,
-                Expected::Holds,
-                "Exact identity.",
             ),
-            lemma_3_15,
+            ClaimKind::Equality,
+            Expected::Holds,
+            "Exact identity.",
         ),
-        Check::new(
-            with(
-                meta(
-                    "thm-3.16-trpo-bound",
-                    "Theorem 3.16 (TRPO lower bound)",
-                    "Section 3.6, Theorem 3.16",
-                    "J(π̃) ≥ L_π(π̃) − C·max_s KL(π(·|s) ‖ π̃(·|s)), C = 4εγ/(1−γ)², \
+        lemma_3_15,
+    )
+}
+
+/// The check `thm-3.16-trpo-bound`.
+fn thm_3_16_check() -> Check {
+    Check::new(
+        with(
+            meta(
+                "thm-3.16-trpo-bound",
+                "Theorem 3.16 (TRPO lower bound)",
+                "Section 3.6, Theorem 3.16",
+                "J(π̃) ≥ L_π(π̃) − C·max_s KL(π(·|s) ‖ π̃(·|s)), C = 4εγ/(1−γ)², \
                      ε = max_{s,a} |A_π(s,a)|, L_π(π̃) = J(π) + 1/(1−γ) Σ_s d^π(s) Σ_a π̃(a|s) A_π(s,a); \
                      π̃ = (1−α)π + απ₂ (cases with infinite KL are skipped).",
-                    GT_EXACT,
-                ),
-                ClaimKind::LowerBound,
-                Expected::Holds,
-                "Holds as printed (Schulman et al.'s unnormalised statement is equivalent).",
+                GT_EXACT,
             ),
-            thm_3_16,
+            ClaimKind::LowerBound,
+            Expected::Holds,
+            "Holds as printed (Schulman et al.'s unnormalised statement is equivalent).",
         ),
-    ]
+        thm_3_16,
+    )
 }

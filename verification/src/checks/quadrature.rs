@@ -312,6 +312,20 @@ const SAMPLING_WD: &str = "proptest: w ∈ {0} or U[−4, 3]; Δw ∈ {0, ±1e-3
 
 /// The Appendix A checks, in registry order.
 pub(crate) fn checks() -> Vec<Check> {
+    vec![
+        psi_constant_check(),
+        second_derivative_formula_check(),
+        second_derivative_bound_check(),
+        lemma_a2_printed_check(),
+        lemma_a2_rigorous_check(),
+        l1_formula_check(),
+        l1_squared_check(),
+        kl_chain_check(),
+    ]
+}
+
+/// The check `lemma-a.1-psi-constant`.
+fn psi_constant_check() -> Check {
     let mut psi = meta(
         "lemma-a.1-psi-constant",
         "Lemma A.1 (the constant ψ)",
@@ -328,7 +342,11 @@ pub(crate) fn checks() -> Vec<Check> {
     psi.cases_full = 1;
     psi.cases_quick = 1;
     psi.notes = "The printed constant and stationary points are right.".into();
+    Check::new(psi, psi_constant)
+}
 
+/// The check `lemma-a.1-second-derivative-formula`.
+fn second_derivative_formula_check() -> Check {
     let mut formula = meta(
         "lemma-a.1-second-derivative-formula",
         "Lemma A.1, eq. (A.3) (second derivative in w)",
@@ -347,7 +365,11 @@ pub(crate) fn checks() -> Vec<Check> {
         error and the ε/h² rounding (≲ 1e-9)"
         .into();
     formula.notes = "Formula (A.3) is right.".into();
+    Check::new(formula, second_derivative_formula)
+}
 
+/// The check `lemma-a.1-second-derivative-bound`.
+fn second_derivative_bound_check() -> Check {
     let mut bound = meta(
         "lemma-a.1-second-derivative-bound",
         "Lemma A.1 (bound on ∂²π/∂w²)",
@@ -357,7 +379,11 @@ pub(crate) fn checks() -> Vec<Check> {
         SAMPLING_ZW,
     );
     bound.notes = "Holds and is attained at χ = 4 − √7 (margin 0 up to rounding).".into();
+    Check::new(bound, second_derivative_bound)
+}
 
+/// The check `lemma-a.2-printed`.
+fn lemma_a2_printed_check() -> Check {
     let mut a2 = meta(
         "lemma-a.2-printed",
         "Lemma A.2 (first-order lower bound in Δw), as printed",
@@ -372,7 +398,11 @@ pub(crate) fn checks() -> Vec<Check> {
         remainder at w + εΔw with ψ/σ_w, but Lemma A.1 gives ψ/σ_{w+εΔw}, larger than ψ/σ_w when \
         Δw < 0. Rigorous form: ψΔw²/(2 min(σ_w, σ_{w+Δw})) (lemma-a.2-rigorous)."
         .into();
+    Check::new(a2, lemma_a2_printed)
+}
 
+/// The check `lemma-a.2-rigorous`.
+fn lemma_a2_rigorous_check() -> Check {
     let mut a2r = meta(
         "lemma-a.2-rigorous",
         "Lemma A.2 with the remainder bounded at min(σ, σ')",
@@ -383,7 +413,11 @@ pub(crate) fn checks() -> Vec<Check> {
     );
     a2r.kind = ClaimKind::LowerBound;
     a2r.notes = "Holds: Lemma A.1 at every point between w and w + Δw.".into();
+    Check::new(a2r, lemma_a2_rigorous)
+}
 
+/// The check `lemma-a.3-l1-closed-form`.
+fn l1_formula_check() -> Check {
     let mut l1f = meta(
         "lemma-a.3-l1-closed-form",
         "Lemma A.3 ground truth (L1 distance of same-mean Gaussians)",
@@ -403,7 +437,11 @@ pub(crate) fn checks() -> Vec<Check> {
     l1f.cases_quick = 30;
     l1f.false_alarm_rate = "0: deterministic; Simpson error ≈ 1e-13 with the kink on a node".into();
     l1f.notes = "The closed form used by lemma-a.3-l1-squared is right.".into();
+    Check::new(l1f, l1_formula)
+}
 
+/// The check `lemma-a.3-l1-squared`.
+fn l1_squared_check() -> Check {
     let mut a3 = meta(
         "lemma-a.3-l1-squared",
         "Lemma A.3 (squared policy distance)",
@@ -417,7 +455,11 @@ pub(crate) fn checks() -> Vec<Check> {
         KL(π_w ‖ π_{w+Δw}) for Δw > 0 and KL(π_{w+Δw} ‖ π_w) for Δw < 0 gives ≤ 2Δw² since \
         e^{−x} ≤ 1 − x + x²/2 for x ≥ 0. Pinsker is loose here: ‖·‖₁² ≈ 0.94Δw² for small Δw."
         .into();
+    Check::new(a3, l1_squared)
+}
 
+/// The check `lemma-a.3-printed-kl-chain`.
+fn kl_chain_check() -> Check {
     let mut chain = meta(
         "lemma-a.3-printed-kl-chain",
         "Lemma A.3 proof step (A.6)–(A.8)",
@@ -433,15 +475,5 @@ pub(crate) fn checks() -> Vec<Check> {
         (lemma-a.3-l1-squared) with the other KL direction. (A.7) also has a typo: \
         σ_{w'}²/(2σ_w² − ½) should read σ_{w'}²/(2σ_w²) − ½."
         .into();
-
-    vec![
-        Check::new(psi, psi_constant),
-        Check::new(formula, second_derivative_formula),
-        Check::new(bound, second_derivative_bound),
-        Check::new(a2, lemma_a2_printed),
-        Check::new(a2r, lemma_a2_rigorous),
-        Check::new(l1f, l1_formula),
-        Check::new(a3, l1_squared),
-        Check::new(chain, kl_chain),
-    ]
+    Check::new(chain, kl_chain)
 }
