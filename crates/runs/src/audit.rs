@@ -717,6 +717,47 @@ fn parse_log(
     Ok(rows)
 }
 
+/// How far a run folder's log goes: iterations done, iterations configured, and whether the
+/// run finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LogExtent {
+    /// Iterations completed and logged.
+    pub(crate) done: u64,
+    /// Iterations the configuration asks for.
+    pub(crate) total: u64,
+    /// Whether the run finished (`log.csv` and a matching `summary.json`).
+    pub(crate) complete: bool,
+}
+
+/// Validates the log of the run folder `dir` exactly as [`audit`] reads it (header, width
+/// and cells of every row, and every logged iteration present in order), naming the log file
+/// and its first bad line in the error.
+///
+/// # Errors
+/// [`Error::Invalid`] for a folder that is not a run, a malformed, truncated or NaN-holding
+/// log, or a summary or checkpoint that does not fit the configuration.
+pub(crate) fn log_extent(dir: &Path) -> Result<LogExtent> {
+    let resolved = load_resolved(dir)?;
+    let total = resolved.iterations();
+    let (bytes, progress) = log_bytes(dir, total, resolved.dims)?;
+    let file = if progress.complete {
+        LOG_FILE
+    } else {
+        PARTIAL_LOG_FILE
+    };
+    parse_log(
+        &dir.join(file),
+        &bytes,
+        resolved.dims,
+        (progress.done, resolved.log_every(), total),
+    )?;
+    Ok(LogExtent {
+        done: progress.done,
+        total,
+        complete: progress.complete,
+    })
+}
+
 /// The algorithm of `spec` under its configuration name (`sepg-zv`), with the requirement of
 /// `sepg-naive-w` (`sepg-naive-w, requirement zv`).
 fn algorithm_name(spec: &RunSpec) -> String {
