@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 use crate::error::{Error, Result};
 use sepg_algo::core::options::Accounting;
 
-use crate::audit::{LogExtent, log_extent};
 use crate::figure::{
     self, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, BandKind, Figure, MIN_BAND_SEEDS, Panel, Scale,
     Series, Style, bootstrap_indices, mean_band_on, mean_halfwidth,
 };
 use crate::folder::{CONFIG_FILE, Log, SUMMARY_FILE, Summary, load_resolved, read_summary};
+use crate::logcheck::{LogCheck, validate_log};
 use crate::reproduce::{Experiment, ReproduceOptions, Setting, TABLE_VARIANTS};
 use crate::spec::EnvName;
 use crate::sweep::{SWEEP_FILE, Seeds, SweepFile};
@@ -657,12 +657,13 @@ fn finish_panel(col: &str, panel: Panel) -> Panel {
     }
 }
 
-/// The log of the run folder `dir`, validated as the audit reads it (every row present, of
-/// the header's width, every cell a finite number or empty where allowed), and how far it
-/// goes. Errors name the log file and its first bad line.
-fn validated_log(dir: &Path) -> Result<(Log, LogExtent)> {
-    let extent = log_extent(dir)?;
-    Ok((Log::read_run(dir)?, extent))
+/// The log of the run folder `dir`, validated as the audit reads it ([`validate_log`]: every
+/// row present, of the header's width, every cell a finite number or empty where allowed),
+/// and how far it goes. Errors name the log file and its first bad line.
+fn validated_log(dir: &Path) -> Result<(Log, LogCheck)> {
+    let check = validate_log(dir)?;
+    check.require_valid()?;
+    Ok((Log::read_run(dir)?, check))
 }
 
 /// The mark of a run that has not finished: "incomplete: k of n iterations".
@@ -706,7 +707,7 @@ fn run_title(dir: &Path) -> Result<String> {
 }
 
 fn one_run(dir: &Path, x_axis: XAxis) -> Result<Figure> {
-    let (log, extent) = validated_log(dir)?;
+    let (log, check) = validated_log(dir)?;
     let x = log.column(x_axis.column()).ok_or_else(|| {
         Error::invalid(format!(
             "{}: log has no {} column",
@@ -755,10 +756,10 @@ fn one_run(dir: &Path, x_axis: XAxis) -> Result<Figure> {
         })
         .collect();
     let mut title = run_title(dir)?;
-    if !extent.complete {
+    if !check.complete {
         title.push_str(&format!(
             " ({})",
-            incomplete_mark(extent.done, extent.total)
+            incomplete_mark(check.iterations_done, check.iterations_expected)
         ));
     }
     Ok(Figure {
@@ -784,9 +785,9 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
             display_name(&r.variant),
             r.sigma0
         );
-        let (log, extent) = validated_log(&run_dir)?;
-        done += extent.done;
-        total += extent.total;
+        let (log, check) = validated_log(&run_dir)?;
+        done += check.iterations_done;
+        total += check.iterations_expected;
         match groups.iter_mut().find(|(l, _)| *l == label) {
             Some((_, logs)) => logs.push(log),
             None => groups.push((label, vec![log])),
