@@ -78,6 +78,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement};
@@ -92,6 +93,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::folder::{SUMMARY_FILE, Summary, load_resolved};
 use crate::logcheck::{Row, bad, log_bytes, parse_log};
+use crate::run::{Observer, Silent};
 use crate::spec::{AlgoName, RunSpec};
 
 /// Family-wise significance level of the tests of a run (and of the groups of a sweep),
@@ -420,23 +422,43 @@ fn key(v: &[f64], w: &[f64]) -> Vec<u64> {
 
 /// Exact J at every point of `points` (keys of [`key`]), evaluated in parallel; the first
 /// error in key order is returned, so the outcome does not depend on the number of threads.
-fn evaluate_all(exact: &ExactJ, points: Vec<Vec<u64>>) -> Result<HashMap<Vec<u64>, f64>> {
+/// Progress goes to `observer` in units of the audited iterations: `begin(0, iterations)`,
+/// then `advance` with the share of the distinct points evaluated so far (at most every
+/// [`PROGRESS_EVERY`] points), then `end`.
+fn evaluate_all(
+    exact: &ExactJ,
+    points: Vec<Vec<u64>>,
+    iterations: u64,
+    observer: &dyn Observer,
+) -> Result<HashMap<Vec<u64>, f64>> {
     let mut points = points;
     points.sort_unstable();
     points.dedup();
+    let total = points.len() as u64;
+    observer.begin(0, iterations);
+    let done = AtomicU64::new(0);
     let values: Vec<Result<f64>> = points
         .par_iter()
         .map(|k| {
             let point: Vec<f64> = k.iter().map(|b| f64::from_bits(*b)).collect();
-            exact.j(&point)
+            let value = exact.j(&point);
+            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if n % PROGRESS_EVERY == 0 || n == total {
+                observer.advance(iterations * n / total.max(1));
+            }
+            value
         })
         .collect();
+    observer.end();
     let mut out = HashMap::with_capacity(points.len());
     for (k, value) in points.into_iter().zip(values) {
         out.insert(k, value?);
     }
     Ok(out)
 }
+
+/// Points evaluated between two progress reports of [`evaluate_all`].
+const PROGRESS_EVERY: u64 = 64;
 
 /// Where J comes from for the environment of the run, and its label.
 fn source(env: &AnyEnv, horizon: usize, dim_v: usize) -> Result<(Option<ExactJ>, String)> {
@@ -841,6 +863,21 @@ fn judge(
 /// (see the module documentation) or a tolerance or level out of range; [`Error::Failed`]
 /// when the oracle cannot evaluate a logged policy.
 pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
+    audit_observed(dir, tolerance, alpha, &Silent)
+}
+
+/// [`audit`], reporting its progress to `observer` (the exact-J evaluations, in audited
+/// iterations; they run in parallel on the rayon pool, and the report is the same bit for bit
+/// whatever the number of threads).
+///
+/// # Errors
+/// As [`audit`].
+pub fn audit_observed(
+    dir: &Path,
+    tolerance: f64,
+    alpha: f64,
+    observer: &dyn Observer,
+) -> Result<AuditReport> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(Error::invalid(format!(
             "--tolerance {tolerance} must be finite and >= 0"
@@ -920,7 +957,7 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
         }
     }
     let js = match &exact {
-        Some(e) => evaluate_all(e, points)?,
+        Some(e) => evaluate_all(e, points, rows.len() as u64, observer)?,
         None => HashMap::new(),
     };
     let mut auditor = Auditor {
@@ -1297,7 +1334,7 @@ mod tests {
         for s in &steps {
             walk.points(s, &plans, &mut points);
         }
-        let js = evaluate_all(&exact(&LqgModel::thesis()), points).expect("exact J");
+        let js = evaluate_all(&exact(&LqgModel::thesis()), points, 1, &Silent).expect("exact J");
         let j0 = js[&key(&rows[0].v, &rows[0].w)];
         let mut a = Auditor {
             tolerance: DEFAULT_TOLERANCE,
@@ -1667,12 +1704,14 @@ mod tests {
             .map(|i| key(&[-1.2 + 0.05 * f64::from(i)], &[w() + 0.01 * f64::from(i)]))
             .collect();
         let e = exact(&LqgModel::lqg1d());
-        let many = evaluate_all(&e, points.clone()).expect("J");
+        let many = evaluate_all(&e, points.clone(), 24, &Silent).expect("J");
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
             .expect("pool");
-        let one = pool.install(|| evaluate_all(&e, points)).expect("J");
+        let one = pool
+            .install(|| evaluate_all(&e, points, 24, &Silent))
+            .expect("J");
         assert_eq!(many, one);
     }
 
