@@ -443,7 +443,7 @@ fn evaluate_all(
             let point: Vec<f64> = k.iter().map(|b| f64::from_bits(*b)).collect();
             let value = exact.j(&point);
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if n % PROGRESS_EVERY == 0 || n == total {
+            if n.is_multiple_of(PROGRESS_EVERY) || n == total {
                 observer.advance(iterations * n / total.max(1));
             }
             value

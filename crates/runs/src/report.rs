@@ -317,13 +317,16 @@ fn scale_of(col: &str) -> Scale {
     }
 }
 
+/// A quantity read from a log, and the scale of its mean and band across seeds.
+type Quantity<'a> = (&'a dyn Fn(&Log) -> Option<Vec<f64>>, Scale);
+
 /// Curves of `y` against column `x_col` for every run of (preset, variant) at σ⁰, as mean
 /// and band of kind `band` on `scale` across seeds.
 fn series(
     runs: &[Loaded],
     (preset, variant, sigma0): (EnvName, &str, f64),
     x_col: &str,
-    (y, scale): (&dyn Fn(&Log) -> Option<Vec<f64>>, Scale),
+    (y, scale): Quantity<'_>,
     band: BandKind,
 ) -> Option<Series> {
     let group: Vec<&Loaded> = runs
@@ -381,12 +384,7 @@ impl PanelMaker<'_> {
     }
 
     /// A panel with one curve of `y` (on its scale) per variant.
-    fn panel_of(
-        &self,
-        title: &str,
-        y_label: &str,
-        y: (&dyn Fn(&Log) -> Option<Vec<f64>>, Scale),
-    ) -> Panel {
+    fn panel_of(&self, title: &str, y_label: &str, y: Quantity<'_>) -> Panel {
         Panel {
             title: title.to_owned(),
             x_label: self.x_axis.label().to_owned(),
