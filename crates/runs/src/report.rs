@@ -49,6 +49,27 @@ pub const THESIS_TABLE_5_1: [(f64, [f64; 11]); 4] = [
     ),
 ];
 
+/// The cells of [`THESIS_TABLE_5_1`] as the thesis prints them (same order), whose digits
+/// set the rounding part of each cell's tolerance ("0.510" has three, "0.29" two).
+pub const THESIS_TABLE_5_1_PRINTED: [[&str; 11]; 4] = [
+    [
+        "0.126", "0.432", "0.506", "0.132", "0.026", "0.228", "0.515", "0.510", "0.368", "0.429",
+        "0.435",
+    ],
+    [
+        "0.08", "0.429", "0.506", "0.124", "0.018", "0.201", "0.515", "0.494", "0.039", "0.028",
+        "0.056",
+    ],
+    [
+        "0.061", "0.428", "0.506", "0.122", "0.012", "0.125", "0.511", "0.29", "0.009", "0.01",
+        "0.006",
+    ],
+    [
+        "0.046", "0.422", "0.505", "0.122", "0.011", "0.069", "0.497", "0.01", "0.021", "0.021",
+        "0.028",
+    ],
+];
+
 /// A finished run of the sweep: its entry, summary and log.
 struct Loaded {
     preset: EnvName,
@@ -123,11 +144,10 @@ pub struct CellComparison {
     pub reproduces: Option<bool>,
 }
 
-/// Half a unit of the last printed digit of the published value `p` (0.0005 for 0.021,
-/// 0.005 for 0.01), read from its shortest decimal form.
-fn rounding(p: f64) -> f64 {
-    let text = format!("{p}");
-    let digits = text.split_once('.').map_or(0, |(_, f)| f.len());
+/// Half a unit of the last printed digit of the published value `printed` (0.0005 for
+/// "0.021" and "0.510", 0.005 for "0.01").
+fn rounding(printed: &str) -> f64 {
+    let digits = printed.split_once('.').map_or(0, |(_, f)| f.len());
     0.5 * 10f64.powi(-(digits as i32))
 }
 
@@ -137,10 +157,11 @@ fn upper_bound(ys: &[f64]) -> Option<f64> {
     half.map(|h| mean + h)
 }
 
-/// The comparison of the errors |v − v*| of one cell's seeds with the published value `p`
-/// (see [`CellComparison`]); the bootstrap uses Xoshiro256++ seeded with [`BOOTSTRAP_SEED`],
-/// so the tolerance is the same on every machine.
-pub fn compare_cell(errors: &[f64], p: f64) -> CellComparison {
+/// The comparison of the errors |v − v*| of one cell's seeds with the published value `p`,
+/// printed as `printed` (its digits set the rounding; see [`CellComparison`]); the
+/// bootstrap uses Xoshiro256++ seeded with [`BOOTSTRAP_SEED`], so the tolerance is the same
+/// on every machine.
+pub fn compare_cell(errors: &[f64], p: f64, printed: &str) -> CellComparison {
     let k = errors.len();
     let (mean, _) = mean_halfwidth(errors);
     let ucb = upper_bound(errors);
@@ -159,7 +180,7 @@ pub fn compare_cell(errors: &[f64], p: f64) -> CellComparison {
         let n = us.len() as f64;
         let m = us.iter().sum::<f64>() / n;
         let sd_k = (us.iter().map(|u| (u - m) * (u - m)).sum::<f64>() / (n - 1.0)).sqrt();
-        rounding(p) + 1.96 * std::f64::consts::SQRT_2 * sd_k
+        rounding(printed) + 1.96 * std::f64::consts::SQRT_2 * sd_k
     });
     let reproduces = ucb.zip(tolerance).map(|(u, tol)| (u - p).abs() <= tol);
     CellComparison {
@@ -219,7 +240,9 @@ fn table(
         let _ = writeln!(md, "## Preset `{}`\n", preset.name());
         let _ = writeln!(md, "| σ⁰ | {} |", TABLE_VARIANTS.join(" | "));
         let _ = writeln!(md, "|---|{}", "---|".repeat(TABLE_VARIANTS.len()));
-        for (sigma0, thesis) in THESIS_TABLE_5_1 {
+        for ((sigma0, thesis), printed) in
+            THESIS_TABLE_5_1.into_iter().zip(THESIS_TABLE_5_1_PRINTED)
+        {
             let mut cells = Vec::new();
             for (col, name) in TABLE_VARIANTS.iter().enumerate() {
                 let errors: Vec<f64> = runs
@@ -227,7 +250,7 @@ fn table(
                     .filter(|r| r.preset == preset && r.variant == *name && r.sigma0 == sigma0)
                     .filter_map(|r| r.summary.abs_v_error)
                     .collect();
-                let c = compare_cell(&errors, thesis[col]);
+                let c = compare_cell(&errors, thesis[col], printed[col]);
                 fewest = fewest.min(c.seeds);
                 let cell = match (c.ucb, c.tolerance, c.reproduces) {
                     (Some(u), Some(tol), Some(ok)) => format!(
@@ -235,9 +258,9 @@ fn table(
                         fmt3(u),
                         if ok { "✓" } else { "✗" },
                         fmt_tol(tol),
-                        thesis[col]
+                        printed[col]
                     ),
-                    _ => format!("n/a [{}]", thesis[col]),
+                    _ => format!("n/a [{}]", printed[col]),
                 };
                 cells.push(cell);
                 let _ = writeln!(
@@ -248,7 +271,7 @@ fn table(
                     csv_num(c.mean),
                     c.sd.map_or_else(String::new, csv_num),
                     c.ucb.map_or_else(String::new, csv_num),
-                    thesis[col],
+                    printed[col],
                     c.tolerance.map_or_else(String::new, csv_num),
                     c.reproduces.map_or("", |ok| if ok { "yes" } else { "no" }),
                 );
@@ -942,6 +965,30 @@ mod tests {
         }
         let b = with_zero_line(Panel::default());
         assert_eq!(b.hlines, vec![("B = 0".to_owned(), 0.0)]);
+    }
+
+    #[test]
+    fn published_cells_keep_their_printed_digits() {
+        for ((_, values), printed) in THESIS_TABLE_5_1.iter().zip(THESIS_TABLE_5_1_PRINTED) {
+            for (v, p) in values.iter().zip(printed) {
+                assert_eq!(p.parse::<f64>().ok(), Some(*v), "{p}");
+            }
+        }
+        // "0.510" is printed to three decimals although 0.510 as a number reads 0.51.
+        assert_eq!(rounding(THESIS_TABLE_5_1_PRINTED[0][7]), 0.0005);
+        assert_eq!(rounding("0.29"), 0.005);
+        // Seeds that all agree: no sampling part, the rounding alone.
+        let same = compare_cell(&[0.5104; 10], 0.510, "0.510");
+        // (Up to the round-off of the mean of equal values, 1e-16.)
+        let tol = same.tolerance.expect("ten seeds");
+        assert!((tol - 0.0005).abs() < 1e-12, "{tol}");
+        assert_eq!(same.reproduces, Some(true));
+        assert_eq!(
+            compare_cell(&[0.5106; 10], 0.510, "0.510").reproduces,
+            Some(false)
+        );
+        let one = compare_cell(&[0.2], 0.29, "0.29");
+        assert_eq!((one.ucb, one.tolerance, one.reproduces), (None, None, None));
     }
 
     /// Mean and sample standard deviation of `ys`, computed here from the definitions.
