@@ -329,6 +329,8 @@ fn figures_and_plots_are_png_and_svg() {
     // The budget panel carries its B = 0 line (in the legend as a reference line).
     let sweep_svg = std::fs::read_to_string(dir.join("plot.svg")).expect("svg");
     assert!(sweep_svg.contains("B = 0") && sweep_svg.contains("budget"));
+    // Under the default setting every budget is certified, and the panel says so.
+    assert!(sweep_svg.contains("budget Bᵗ (certified: sums of certified improvements)"));
     let run = dir.join("runs/lqg/mi/sigma-1.0/seed-0");
     let file = tmp.path().join("one.svg");
     ok(&[

@@ -424,6 +424,17 @@ impl PanelMaker<'_> {
         }
     }
 
+    /// `title` with the kind of the preset's budgets (certified or estimated).
+    fn budget_title(&self, title: &str) -> String {
+        let kinds: Vec<&str> = self
+            .runs
+            .iter()
+            .filter(|r| r.preset == self.preset)
+            .map(|r| accounting_words(r.summary.options.accounting))
+            .collect();
+        budget_title(title, &kinds)
+    }
+
     /// The panel of v, with v* as a reference line when known.
     fn v_panel(&self, title: &str) -> Panel {
         let mut p = self.panel(title, "v", "v");
@@ -472,7 +483,7 @@ impl PanelMaker<'_> {
                 self.v_panel("(c) mean parameter vᵗ"),
                 self.guarantee_panel(),
                 self.panel("(e) target J(θ_{T})", "J", "j_target"),
-                with_zero_line(self.panel("(f) budget Bᵗ", "B", "budget")),
+                with_zero_line(self.panel(&self.budget_title("(f) budget Bᵗ"), "B", "budget")),
             ],
             Experiment::Fig53 => vec![
                 self.panel("(a) exploratory J(θ_{E})", "J", "j_explore"),
@@ -700,10 +711,25 @@ fn budget_kind(dir: &Path) -> Result<&'static str> {
         Ok(s) => s.options.accounting,
         Err(_) => load_resolved(dir)?.checked.config().options.accounting,
     };
-    Ok(match accounting {
+    Ok(accounting_words(accounting))
+}
+
+/// How the budget panel names an accounting.
+fn accounting_words(accounting: Accounting) -> &'static str {
+    match accounting {
         Accounting::Certified => "certified: sums of certified improvements",
         Accounting::Estimated => "estimated: differences of estimated J, no guarantee",
-    })
+    }
+}
+
+/// The budget panel's title for runs whose budgets are of the kinds `kinds` (one entry per
+/// run): the kind when they agree, both when they differ.
+fn budget_title(title: &str, kinds: &[&str]) -> String {
+    match kinds.first() {
+        Some(first) if kinds.iter().all(|k| k == first) => format!("{title} ({first})"),
+        Some(_) => format!("{title} (certified and estimated runs)"),
+        None => title.to_owned(),
+    }
 }
 
 /// The title of the run in `dir`: environment, algorithm, σ⁰, N and seed.
@@ -795,6 +821,7 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
     let x_axis = opts.x_axis.unwrap_or(XAxis::Iteration);
     let mut groups: Vec<(String, Vec<Log>)> = Vec::new();
     let (mut done, mut total) = (0, 0);
+    let mut kinds = Vec::new();
     for r in file.shard_runs() {
         let run_dir = dir.join(&r.dir);
         if !run_dir.join(CONFIG_FILE).is_file() {
@@ -807,6 +834,7 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
             r.sigma0
         );
         let (log, check) = validated_log(&run_dir)?;
+        kinds.push(budget_kind(&run_dir)?);
         done += check.iterations_done;
         total += check.iterations_expected;
         match groups.iter_mut().find(|(l, _)| *l == label) {
@@ -841,10 +869,10 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
                     })
                 })
                 .collect();
-            let title = if col == "sigma" {
-                format!("{title} (geometric mean)")
-            } else {
-                title.to_owned()
+            let title = match col {
+                "sigma" => format!("{title} (geometric mean)"),
+                "budget" => budget_title(title, &kinds),
+                _ => title.to_owned(),
             };
             let panel = Panel {
                 title,
