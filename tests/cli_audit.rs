@@ -1115,3 +1115,50 @@ fn the_reviews_lb2_run_from_the_optimum() {
         assert_eq!(c["failed"].as_u64(), Some(0), "{c}");
     }
 }
+
+/// The audit evaluates exact J in parallel: with one thread and with two, its report (text
+/// and JSON) is the same byte for byte. A sampled `lqg1d` run of 300 iterations with the
+/// thesis's bookkeeping, whose parameters move at every iteration, so that every audited
+/// point is distinct.
+#[test]
+fn the_audit_report_does_not_depend_on_the_number_of_threads() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = tmp.path().join("moving");
+    run(
+        &dir,
+        &[
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-zv",
+            "--accounting",
+            "estimated",
+            "--confidence",
+            "none",
+            "--iterations",
+            "300",
+            "--seed",
+            "1",
+        ],
+    );
+    let audit = |threads: &str, json: bool| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_sepg"));
+        cmd.env("RAYON_NUM_THREADS", threads).arg("audit");
+        if json {
+            cmd.arg("--json");
+        }
+        let out = cmd.arg(path(&dir)).output().expect("the sepg binary runs");
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    for json in [false, true] {
+        let one = audit("1", json);
+        assert!(!one.is_empty());
+        assert_eq!(one, audit("2", json), "json: {json}");
+    }
+}

@@ -9,12 +9,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use sepg_runs::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, Verdict, audit, render};
+use sepg_runs::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, Verdict, audit_observed, render};
 use sepg_runs::sweep::{
     AUDIT_GROUPS_CSV, GroupVerdict, SUMMARY_CSV, SWEEP_FILE, SweepFile, audit_sweep,
 };
 
 use crate::cli::CliError;
+use crate::progress::Bar;
 
 /// Arguments of `sepg audit`.
 #[derive(Debug, Args)]
@@ -63,7 +64,10 @@ pub fn run(args: &AuditArgs) -> Result<(), CliError> {
     if args.dir.join(SWEEP_FILE).is_file() {
         return sweep(args);
     }
-    let report = audit(&args.dir, args.tolerance, args.alpha)?;
+    // The exact-J evaluations, in parallel over the audited iterations, with a progress bar
+    // when standard error is a terminal.
+    let bar = Bar::iterations(true);
+    let report = audit_observed(&args.dir, args.tolerance, args.alpha, &bar)?;
     if args.json {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::failure(format!("cannot serialise the report: {e}")))?;

@@ -14,7 +14,7 @@ use crate::output::write_atomic;
 /// Arguments of `sepg verify`.
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
-    /// Fewer cases per check (the CI subset, a few seconds in release).
+    /// Fewer cases per check (the CI subset: about 55 s of CPU time in release).
     #[arg(long)]
     quick: bool,
     /// Run only the checks whose identifier contains this text (e.g. `thm-3.3`).

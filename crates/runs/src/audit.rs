@@ -77,8 +77,8 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
-use std::fs;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement};
@@ -91,10 +91,9 @@ use sepg_mdp::oracle::{
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::folder::{
-    CHECKPOINT_FILE, Checkpoint, LOG_FILE, PARTIAL_LOG_FILE, SUMMARY_FILE, Summary, load_resolved,
-    log_header,
-};
+use crate::folder::{SUMMARY_FILE, Summary, load_resolved};
+use crate::logcheck::{Row, bad, log_bytes, parse_log};
+use crate::run::{Observer, Silent};
 use crate::spec::{AlgoName, RunSpec};
 
 /// Family-wise significance level of the tests of a run (and of the groups of a sweep),
@@ -372,351 +371,6 @@ pub fn broken_runs_p_value(failed: u64, runs: u64, rate: f64) -> Result<f64> {
     upper_tail(failed, runs, rate).map_err(|e| Error::invalid(format!("binomial test: {e}")))
 }
 
-/// One parsed row of `log.csv`.
-#[derive(Debug, Clone)]
-struct Row {
-    iteration: u64,
-    v: Vec<f64>,
-    w: Vec<f64>,
-    w_target: Vec<f64>,
-    budget: f64,
-    alpha: f64,
-    beta: f64,
-    guaranteed_v: Option<f64>,
-    guaranteed_w: Option<f64>,
-}
-
-fn bad(dir: &Path, what: impl std::fmt::Display) -> Error {
-    Error::invalid(format!("{}: {what}", dir.display()))
-}
-
-/// Columns holding counters (non-negative integers).
-const INTEGER_COLUMNS: [&str; 8] = [
-    "iteration",
-    "infeasible",
-    "infeasible_v",
-    "infeasible_w",
-    "below_noise_v",
-    "below_noise_w",
-    "trajectories",
-    "steps",
-];
-
-/// Columns that are empty when they do not apply to the algorithm or the iteration.
-const OPTIONAL_COLUMNS: [&str; 9] = [
-    "certified_v",
-    "certified_w",
-    "j_after_v",
-    "required",
-    "required_w",
-    "lambda_v",
-    "lambda_w",
-    "guaranteed_v",
-    "guaranteed_w",
-];
-
-/// How the cells of a column are validated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Cell {
-    /// A non-negative integer.
-    Integer,
-    /// A finite number, or empty.
-    Optional,
-    /// A finite number, or `-inf` (the deterministic target's log standard deviation).
-    WTarget,
-    /// A finite number.
-    Number,
-}
-
-fn cell_kind(name: &str) -> Cell {
-    if INTEGER_COLUMNS.contains(&name) {
-        Cell::Integer
-    } else if OPTIONAL_COLUMNS.contains(&name) {
-        Cell::Optional
-    } else if name == "w_target" || name.starts_with("w_target_") {
-        Cell::WTarget
-    } else {
-        Cell::Number
-    }
-}
-
-/// The configuration, the completed iterations and the parameters after the last one.
-struct Progress {
-    /// Iterations completed (= the configured total for a finished run).
-    done: u64,
-    /// Whether the run finished (`log.csv` and a matching `summary.json`).
-    complete: bool,
-    /// θ after `done` iterations.
-    last: Params,
-    /// The summary of a finished run.
-    summary: Option<Summary>,
-}
-
-/// Parameters θᵗ = (vᵗ, wᵗ).
-struct Params {
-    v: Vec<f64>,
-    w: Vec<f64>,
-}
-
-fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
-    let path = dir.join(CHECKPOINT_FILE);
-    if !path.is_file() {
-        return Ok(None);
-    }
-    let text = fs::read_to_string(&path)
-        .map_err(|e| bad(dir, format!("cannot read {CHECKPOINT_FILE}: {e}")))?;
-    serde_json::from_str(&text)
-        .map(Some)
-        .map_err(|e| bad(dir, format!("{CHECKPOINT_FILE} is malformed: {e}")))
-}
-
-/// The bytes of the log and the run's progress: `log.csv` with its `summary.json`, or the
-/// checkpointed prefix of `log.partial.csv`.
-fn log_bytes(dir: &Path, total: u64, dims: (usize, usize)) -> Result<(Vec<u8>, Progress)> {
-    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
-    let done = dir.join(LOG_FILE);
-    if done.is_file() {
-        let bytes =
-            fs::read(&done).map_err(|e| bad(dir, format!("cannot read {LOG_FILE}: {e}")))?;
-        let path = dir.join(SUMMARY_FILE);
-        if !path.is_file() {
-            return Err(bad(
-                dir,
-                format!(
-                    "{LOG_FILE} without {SUMMARY_FILE}: the run did not finish writing its folder \
-                     (sepg run --resume {} completes it)",
-                    dir.display()
-                ),
-            ));
-        }
-        let text = fs::read_to_string(&path)
-            .map_err(|e| bad(dir, format!("cannot read {SUMMARY_FILE}: {e}")))?;
-        let s: Summary = serde_json::from_str(&text)
-            .map_err(|e| bad(dir, format!("{SUMMARY_FILE} is malformed: {e}")))?;
-        if s.iterations != total {
-            return Err(bad(
-                dir,
-                format!(
-                    "{SUMMARY_FILE} reports {} iterations, the configuration {total}",
-                    s.iterations
-                ),
-            ));
-        }
-        let (v, w) = (s.final_params.v.clone(), s.final_params.w.clone());
-        if v.len() != dims.0 || w.len() != dims.1 || !finite(&v) || !finite(&w) {
-            return Err(bad(
-                dir,
-                format!("{SUMMARY_FILE}: the final parameters do not fit the run"),
-            ));
-        }
-        let progress = Progress {
-            done: total,
-            complete: true,
-            last: Params { v, w },
-            summary: Some(s),
-        };
-        return Ok((bytes, progress));
-    }
-    let mut bytes = fs::read(dir.join(PARTIAL_LOG_FILE)).map_err(|e| {
-        bad(
-            dir,
-            format!("no {LOG_FILE} and no readable {PARTIAL_LOG_FILE}: {e}"),
-        )
-    })?;
-    let ck = read_checkpoint(dir)?.ok_or_else(|| {
-        bad(
-            dir,
-            format!("{PARTIAL_LOG_FILE} without a valid {CHECKPOINT_FILE}"),
-        )
-    })?;
-    let valid = usize::try_from(ck.log_bytes).unwrap_or(usize::MAX);
-    if valid > bytes.len() {
-        return Err(bad(
-            dir,
-            format!("{PARTIAL_LOG_FILE} is shorter than its checkpoint says"),
-        ));
-    }
-    bytes.truncate(valid);
-    let s = ck.state;
-    if s.iteration > total
-        || s.v.len() != dims.0
-        || s.w.len() != dims.1
-        || !finite(&s.v)
-        || !finite(&s.w)
-    {
-        return Err(bad(
-            dir,
-            format!("{CHECKPOINT_FILE} does not fit the run's configuration"),
-        ));
-    }
-    let progress = Progress {
-        done: s.iteration,
-        complete: false,
-        last: Params { v: s.v, w: s.w },
-        summary: None,
-    };
-    Ok((bytes, progress))
-}
-
-/// Positions of the columns the audit reads, in a header of this run's dimensions.
-struct Columns<'h> {
-    names: Vec<&'h str>,
-    kinds: Vec<Cell>,
-    v: Vec<usize>,
-    w: Vec<usize>,
-    w_target: Vec<usize>,
-    /// budget, alpha, beta, guaranteed_v, guaranteed_w.
-    scalars: [usize; 5],
-}
-
-impl<'h> Columns<'h> {
-    fn new(dir: &Path, header: &'h str, dims: (usize, usize)) -> Result<Columns<'h>> {
-        let names: Vec<&str> = header.split(',').collect();
-        let col = |name: &str| names.iter().position(|c| *c == name);
-        let cols = |name: &str, dim: usize| -> Vec<usize> {
-            if dim == 1 {
-                col(name).into_iter().collect()
-            } else {
-                (0..dim)
-                    .filter_map(|i| col(&format!("{name}_{i}")))
-                    .collect()
-            }
-        };
-        let named = |name: &str| col(name).ok_or_else(|| bad(dir, format!("no column {name}")));
-        let scalars = ["budget", "alpha", "beta", "guaranteed_v", "guaranteed_w"].map(named);
-        let [a, b, c, d, e] = scalars;
-        Ok(Columns {
-            v: cols("v", dims.0),
-            w: cols("w", dims.1),
-            w_target: cols("w_target", dims.1),
-            scalars: [a?, b?, c?, d?, e?],
-            kinds: names.iter().map(|n| cell_kind(n)).collect(),
-            names,
-        })
-    }
-
-    /// Parses line `line_no` of the log (1 is the header): every cell is validated by the
-    /// kind of its column.
-    fn row(&self, dir: &Path, line_no: usize, line: &str) -> Result<Row> {
-        let cells: Vec<&str> = line.split(',').collect();
-        if cells.len() != self.names.len() {
-            return Err(bad(
-                dir,
-                format!(
-                    "log line {line_no} has {} cells, the header {}",
-                    cells.len(),
-                    self.names.len()
-                ),
-            ));
-        }
-        let mut values = Vec::with_capacity(cells.len());
-        for ((c, name), kind) in cells.iter().zip(&self.names).zip(&self.kinds) {
-            let at = || format!("log line {line_no}, column {name}");
-            let value = match kind {
-                Cell::Integer => Some(c.parse::<u64>().map_err(|_| {
-                    bad(
-                        dir,
-                        format!("{}: {c:?} is not a non-negative integer", at()),
-                    )
-                })? as f64),
-                _ if c.is_empty() => {
-                    if *kind != Cell::Optional {
-                        return Err(bad(dir, format!("{} is empty", at())));
-                    }
-                    None
-                }
-                _ => {
-                    let x = c
-                        .parse::<f64>()
-                        .map_err(|_| bad(dir, format!("{}: {c:?} is not a number", at())))?;
-                    let allowed =
-                        x.is_finite() || (*kind == Cell::WTarget && x == f64::NEG_INFINITY);
-                    if !allowed {
-                        return Err(bad(dir, format!("{}: {c} is not a finite number", at())));
-                    }
-                    Some(x)
-                }
-            };
-            values.push(value);
-        }
-        let iteration: u64 = cells[0].parse().unwrap_or_default();
-        let req = |i: usize| values[i].unwrap_or_default();
-        let many = |idx: &[usize]| idx.iter().map(|&i| req(i)).collect::<Vec<_>>();
-        let [ib, ia, ibt, igv, igw] = self.scalars;
-        Ok(Row {
-            iteration,
-            v: many(&self.v),
-            w: many(&self.w),
-            w_target: many(&self.w_target),
-            budget: req(ib),
-            alpha: req(ia),
-            beta: req(ibt),
-            guaranteed_v: values[igv],
-            guaranteed_w: values[igw],
-        })
-    }
-}
-
-/// Whether the run logs the row of iteration `t` (`log-every` k: every k-th and the last).
-fn logged(t: u64, every: u64, total: u64) -> bool {
-    t.is_multiple_of(every) || t + 1 == total
-}
-
-/// Parses the log strictly: the header of this run's dimensions, rows of the same width and
-/// validated cells, and exactly the rows of the first `done` iterations that `log-every`
-/// logs, in order.
-fn parse_log(
-    dir: &Path,
-    bytes: &[u8],
-    dims: (usize, usize),
-    (done, every, total): (u64, u64, u64),
-) -> Result<Vec<Row>> {
-    let text = std::str::from_utf8(bytes).map_err(|_| bad(dir, "the log is not UTF-8"))?;
-    let mut lines = text.split_terminator('\n');
-    let header = log_header(dims.0, dims.1);
-    if lines.next() != Some(header.trim_end()) {
-        return Err(bad(
-            dir,
-            "the log header does not match the run's configuration",
-        ));
-    }
-    let columns = Columns::new(dir, header.trim_end(), dims)?;
-    let mut expected = (0..done).filter(|&t| logged(t, every, total));
-    let mut rows: Vec<Row> = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let line_no = n + 2;
-        let row = columns.row(dir, line_no, line)?;
-        match expected.next() {
-            Some(t) if t == row.iteration => rows.push(row),
-            Some(t) => {
-                return Err(bad(
-                    dir,
-                    format!(
-                        "log line {line_no} is iteration {}, expected {t}: rows are missing or out of order",
-                        row.iteration
-                    ),
-                ));
-            }
-            None => {
-                return Err(bad(
-                    dir,
-                    format!(
-                        "log line {line_no} (iteration {}) is beyond the {done} iterations the run completed",
-                        row.iteration
-                    ),
-                ));
-            }
-        }
-    }
-    if let Some(t) = expected.next() {
-        return Err(bad(
-            dir,
-            format!("the log ends before the row of iteration {t} (rows are missing)"),
-        ));
-    }
-    Ok(rows)
-}
-
 /// The algorithm of `spec` under its configuration name (`sepg-zv`), with the requirement of
 /// `sepg-naive-w` (`sepg-naive-w, requirement zv`).
 fn algorithm_name(spec: &RunSpec) -> String {
@@ -768,23 +422,43 @@ fn key(v: &[f64], w: &[f64]) -> Vec<u64> {
 
 /// Exact J at every point of `points` (keys of [`key`]), evaluated in parallel; the first
 /// error in key order is returned, so the outcome does not depend on the number of threads.
-fn evaluate_all(exact: &ExactJ, points: Vec<Vec<u64>>) -> Result<HashMap<Vec<u64>, f64>> {
+/// Progress goes to `observer` in units of the audited iterations: `begin(0, iterations)`,
+/// then `advance` with the share of the distinct points evaluated so far (at most every
+/// [`PROGRESS_EVERY`] points), then `end`.
+fn evaluate_all(
+    exact: &ExactJ,
+    points: Vec<Vec<u64>>,
+    iterations: u64,
+    observer: &dyn Observer,
+) -> Result<HashMap<Vec<u64>, f64>> {
     let mut points = points;
     points.sort_unstable();
     points.dedup();
+    let total = points.len() as u64;
+    observer.begin(0, iterations);
+    let done = AtomicU64::new(0);
     let values: Vec<Result<f64>> = points
         .par_iter()
         .map(|k| {
             let point: Vec<f64> = k.iter().map(|b| f64::from_bits(*b)).collect();
-            exact.j(&point)
+            let value = exact.j(&point);
+            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if n.is_multiple_of(PROGRESS_EVERY) || n == total {
+                observer.advance(iterations * n / total.max(1));
+            }
+            value
         })
         .collect();
+    observer.end();
     let mut out = HashMap::with_capacity(points.len());
     for (k, value) in points.into_iter().zip(values) {
         out.insert(k, value?);
     }
     Ok(out)
 }
+
+/// Points evaluated between two progress reports of [`evaluate_all`].
+const PROGRESS_EVERY: u64 = 64;
 
 /// Where J comes from for the environment of the run, and its label.
 fn source(env: &AnyEnv, horizon: usize, dim_v: usize) -> Result<(Option<ExactJ>, String)> {
@@ -1189,6 +863,21 @@ fn judge(
 /// (see the module documentation) or a tolerance or level out of range; [`Error::Failed`]
 /// when the oracle cannot evaluate a logged policy.
 pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
+    audit_observed(dir, tolerance, alpha, &Silent)
+}
+
+/// [`audit`], reporting its progress to `observer` (the exact-J evaluations, in audited
+/// iterations; they run in parallel on the rayon pool, and the report is the same bit for bit
+/// whatever the number of threads).
+///
+/// # Errors
+/// As [`audit`].
+pub fn audit_observed(
+    dir: &Path,
+    tolerance: f64,
+    alpha: f64,
+    observer: &dyn Observer,
+) -> Result<AuditReport> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(Error::invalid(format!(
             "--tolerance {tolerance} must be finite and >= 0"
@@ -1268,7 +957,7 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
         }
     }
     let js = match &exact {
-        Some(e) => evaluate_all(e, points)?,
+        Some(e) => evaluate_all(e, points, rows.len() as u64, observer)?,
         None => HashMap::new(),
     };
     let mut auditor = Auditor {
@@ -1645,7 +1334,7 @@ mod tests {
         for s in &steps {
             walk.points(s, &plans, &mut points);
         }
-        let js = evaluate_all(&exact(&LqgModel::thesis()), points).expect("exact J");
+        let js = evaluate_all(&exact(&LqgModel::thesis()), points, 1, &Silent).expect("exact J");
         let j0 = js[&key(&rows[0].v, &rows[0].w)];
         let mut a = Auditor {
             tolerance: DEFAULT_TOLERANCE,
@@ -2015,12 +1704,14 @@ mod tests {
             .map(|i| key(&[-1.2 + 0.05 * f64::from(i)], &[w() + 0.01 * f64::from(i)]))
             .collect();
         let e = exact(&LqgModel::lqg1d());
-        let many = evaluate_all(&e, points.clone()).expect("J");
+        let many = evaluate_all(&e, points.clone(), 24, &Silent).expect("J");
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
             .expect("pool");
-        let one = pool.install(|| evaluate_all(&e, points)).expect("J");
+        let one = pool
+            .install(|| evaluate_all(&e, points, 24, &Silent))
+            .expect("J");
         assert_eq!(many, one);
     }
 

@@ -1,12 +1,21 @@
 //! Figures as PNG and SVG (plotters) with confidence bands across seeds, rendered with an
 //! embedded font so that no system font is needed, and statistics across seeds.
+//!
+//! Every band respects the domain of its quantity (see [`Scale`]): σ > 0 is banded on log σ
+//! and transformed back, the budget by a percentile bootstrap that never leaves the range
+//! its seeds reached, the other quantities by Student t-intervals. Labels may carry
+//! subscripts written `J_{E}` (drawn as J with a lowered, smaller E).
 
 use std::cmp::Ordering;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use plotters::coord::Shift;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
 use sepg_estimators::student_t_quantile;
 
 use crate::error::{Error, Result};
@@ -62,16 +71,27 @@ fn hsl_to_rgb(h: f64, s: f64, l: f64) -> RGBColor {
     RGBColor(byte(r), byte(g), byte(b))
 }
 
+/// Styles of the reference lines of a figure, in order of first appearance: colour, dash
+/// length and gap (pixels at 100 dpi). Each differs from the others in both colour and dash
+/// pattern, and none is a colour of the palette.
+const REFERENCE_STYLES: [(RGBColor, u32, u32); 3] = [
+    (RGBColor(0, 0, 0), 9, 4),
+    (RGBColor(105, 105, 105), 2, 3),
+    (RGBColor(128, 0, 64), 14, 3),
+];
+
 /// What the band around a mean curve shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[non_exhaustive]
 pub enum BandKind {
-    /// Two-sided 95% t-interval of the mean: m ± t(0.975, K − 1)·s/√K (wide for few seeds:
-    /// t(0.975, 1) = 12.7).
+    /// Two-sided 95% interval of the mean: m ± t(0.975, K − 1)·s/√K on the quantity's scale
+    /// (wide for few seeds: t(0.975, 1) = 12.7), or the 95% percentile bootstrap interval
+    /// (see [`Scale`]).
     #[default]
     Ci95,
-    /// One standard error: m ± s/√K.
+    /// One standard error: m ± s/√K on the quantity's scale, or the central 68.27%
+    /// percentile bootstrap interval.
     Se,
     /// No band.
     None,
@@ -81,16 +101,44 @@ impl BandKind {
     /// How the band is described in a figure's title.
     pub fn describe(self) -> &'static str {
         match self {
-            BandKind::Ci95 => "mean and 95% t-interval across seeds",
+            BandKind::Ci95 => "mean and 95% interval across seeds",
             BandKind::Se => "mean ± one standard error across seeds",
             BandKind::None => "mean across seeds",
         }
     }
 }
 
+/// The scale on which a quantity's mean and band across seeds are computed, so that the band
+/// stays in the quantity's domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Scale {
+    /// Any real value (J, v): arithmetic mean and Student t-interval.
+    #[default]
+    Linear,
+    /// Positive values (σ): mean and t-interval of log y, transformed back by exp, i.e. the
+    /// geometric mean with a band that is positive and asymmetric. log σ = w is the
+    /// parameter the algorithm moves, so this is the interval on the quantity it steps.
+    Log,
+    /// Values with a floor that a symmetric band would cross (the budget, which cannot fall
+    /// below what the accounting allows): arithmetic mean and percentile bootstrap interval,
+    /// resampling the seeds with replacement ([`BOOTSTRAP_RESAMPLES`] resamples, the seeded
+    /// portable generator of [`bootstrap_indices`]). A mean of resampled seeds lies between
+    /// the smallest and the largest value of the seeds, so the band never goes below the
+    /// lowest value any seed reached, whatever the floor of the quantity.
+    Bootstrap,
+}
+
 /// Fewest seeds for which a band is worth drawing without a warning: with two seeds the 95%
 /// t-interval uses t(0.975, 1) = 12.7 and the standard error rests on one degree of freedom.
 pub const MIN_BAND_SEEDS: usize = 3;
+
+/// Resamples of every bootstrap (percentile bands and the tolerance of Table 5.1).
+pub const BOOTSTRAP_RESAMPLES: usize = 2000;
+
+/// Seed of the bootstrap's generator (Xoshiro256++), fixed so that figures and tables are
+/// the same bit for bit on every machine.
+pub const BOOTSTRAP_SEED: u64 = 0x5e96_b007;
 
 /// Lower and upper ends of a confidence band, point by point.
 pub type Band = (Vec<f64>, Vec<f64>);
@@ -98,7 +146,7 @@ pub type Band = (Vec<f64>, Vec<f64>);
 /// One curve: a mean over seeds and, with two seeds or more, its 95% confidence band.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
-    /// Legend label.
+    /// Legend label (`_{…}` marks a subscript).
     pub label: String,
     /// Abscissae.
     pub x: Vec<f64>,
@@ -111,7 +159,7 @@ pub struct Series {
 /// One panel of a figure.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Panel {
-    /// Caption.
+    /// Caption (`_{…}` marks a subscript).
     pub title: String,
     /// Abscissa label.
     pub x_label: String,
@@ -119,25 +167,9 @@ pub struct Panel {
     pub y_label: String,
     /// Curves.
     pub series: Vec<Series>,
-    /// Dashed horizontal reference lines (label, value).
+    /// Dashed horizontal reference lines (label, value); each label gets its own colour and
+    /// dash pattern.
     pub hlines: Vec<(String, f64)>,
-}
-
-impl Panel {
-    /// The panel with every band raised to at least `floor`, for quantities that cannot go
-    /// below it (σ ≥ 0): a symmetric band around a mean close to the floor would otherwise
-    /// show impossible values.
-    #[must_use]
-    pub fn clipped_at(mut self, floor: f64) -> Panel {
-        for s in &mut self.series {
-            if let Some((lo, hi)) = &mut s.band {
-                for y in lo.iter_mut().chain(hi.iter_mut()) {
-                    *y = y.max(floor);
-                }
-            }
-        }
-        self
-    }
 }
 
 /// A figure: a title and a grid of panels.
@@ -151,8 +183,67 @@ pub struct Figure {
     pub columns: usize,
 }
 
+/// Size of the text and resolution of a drawn figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Style {
+    /// Size of the tick labels in points (1/72 inch); every other text is scaled with it
+    /// (titles 1.8 times, captions 1.3 times). Default 12, domain [4, 72].
+    pub font_size: f64,
+    /// Resolution in dots per inch: a PNG has dpi/100 times the pixels of the default
+    /// figure in each direction, with every line and text scaled alike (an SVG is scaled
+    /// the same way). Default 100, domain [50, 1200].
+    pub dpi: u32,
+}
+
+impl Default for Style {
+    fn default() -> Style {
+        Style {
+            font_size: 12.0,
+            dpi: 100,
+        }
+    }
+}
+
+impl Style {
+    /// Checks the domains of the font size and resolution.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the option out of its domain.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.font_size.is_finite() && (4.0..=72.0).contains(&self.font_size)) {
+            return Err(Error::invalid(format!(
+                "--font-size {} must be between 4 and 72 points",
+                self.font_size
+            )));
+        }
+        if !(50..=1200).contains(&self.dpi) {
+            return Err(Error::invalid(format!(
+                "--dpi {} must be between 50 and 1200",
+                self.dpi
+            )));
+        }
+        Ok(())
+    }
+
+    /// Pixels per pixel of the default figure.
+    fn px(&self) -> f64 {
+        f64::from(self.dpi) / 100.0
+    }
+
+    /// A length of `base` pixels of the default figure, scaled to this resolution.
+    fn len(&self, base: f64) -> u32 {
+        (base * self.px()).round().max(1.0) as u32
+    }
+
+    /// The pixel size of a text of `base` points at the default font size, scaled to this
+    /// font size and resolution.
+    fn text(&self, base: f64) -> f64 {
+        base * self.font_size / 12.0 * self.px()
+    }
+}
+
 /// Mean and band of kind `kind` across seeds of equally long curves, point by point (the
-/// curves are cut to the shortest).
+/// curves are cut to the shortest), on the linear scale ([`Scale::Linear`]).
 ///
 /// # Formula
 /// ```text
@@ -160,23 +251,113 @@ pub struct Figure {
 /// Ci95: m ± t(0.975, K − 1) · s / √K        Se: m ± s / √K        None: no band
 /// ```
 pub fn mean_band(curves: &[Vec<f64>], kind: BandKind) -> (Vec<f64>, Option<Band>) {
+    mean_band_on(curves, kind, Scale::Linear)
+}
+
+/// Mean and band of kind `kind` across seeds of equally long curves, point by point (the
+/// curves are cut to the shortest), on `scale`:
+///
+/// ```text
+/// Linear:    m = mean(y),           band m ± h(y)            (h as in mean_band)
+/// Log:       m = exp(mean(log y)),  band exp(mean(log y) ± h(log y))   (y > 0; else NaN)
+/// Bootstrap: m = mean(y),           band the (q, 1 − q) percentiles of the means of
+///            BOOTSTRAP_RESAMPLES resamples of the K seeds, q = 0.025 (Ci95) or
+///            0.158655 (Se, one standard deviation of a normal)
+/// ```
+/// A point where a value is not finite (or not positive on the log scale) has a NaN mean and
+/// band, which are not drawn.
+pub fn mean_band_on(curves: &[Vec<f64>], kind: BandKind, scale: Scale) -> (Vec<f64>, Option<Band>) {
     let len = curves.iter().map(Vec::len).min().unwrap_or(0);
     let k = curves.len();
+    let resamples = (scale == Scale::Bootstrap && k >= 2 && kind != BandKind::None)
+        .then(|| bootstrap_indices(k, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED));
     let mut mean = Vec::with_capacity(len);
     let mut lo = Vec::with_capacity(len);
     let mut hi = Vec::with_capacity(len);
+    let mut means = vec![0.0; BOOTSTRAP_RESAMPLES];
     for i in 0..len {
         let ys: Vec<f64> = curves.iter().map(|c| c[i]).collect();
-        let (m, h) = match kind {
-            BandKind::Se => mean_se(&ys),
-            _ => mean_halfwidth(&ys),
+        let (m, l, h) = match scale {
+            Scale::Log => {
+                let logs: Vec<f64> = ys
+                    .iter()
+                    .map(|&y| if y > 0.0 { y.ln() } else { f64::NAN })
+                    .collect();
+                let (m, h) = spread(&logs, kind);
+                (m.exp(), (m - h).exp(), (m + h).exp())
+            }
+            Scale::Linear => {
+                let (m, h) = spread(&ys, kind);
+                (m, m - h, m + h)
+            }
+            Scale::Bootstrap => {
+                let m = ys.iter().sum::<f64>() / k as f64;
+                match &resamples {
+                    Some(idx) => {
+                        for (slot, draw) in means.iter_mut().zip(idx) {
+                            *slot = draw.iter().map(|&j| ys[j]).sum::<f64>() / k as f64;
+                        }
+                        let q = if kind == BandKind::Se {
+                            0.158_655_253_931_457
+                        } else {
+                            0.025
+                        };
+                        (
+                            m,
+                            percentile(&mut means, q),
+                            percentile(&mut means, 1.0 - q),
+                        )
+                    }
+                    None => (m, m, m),
+                }
+            }
         };
         mean.push(m);
-        lo.push(m - h.unwrap_or(0.0));
-        hi.push(m + h.unwrap_or(0.0));
+        lo.push(l);
+        hi.push(h);
     }
     let band = (k >= 2 && kind != BandKind::None).then_some((lo, hi));
     (mean, band)
+}
+
+/// Mean of `ys` and the half-width of a band of kind `kind` (0 when there is none).
+fn spread(ys: &[f64], kind: BandKind) -> (f64, f64) {
+    let (m, h) = match kind {
+        BandKind::Se => mean_se(ys),
+        _ => mean_halfwidth(ys),
+    };
+    (
+        m,
+        if kind == BandKind::None {
+            0.0
+        } else {
+            h.unwrap_or(0.0)
+        },
+    )
+}
+
+/// The `q`-quantile of `xs` (0 ≤ q ≤ 1) by the nearest-rank rule: the ⌈q·n⌉-th smallest value
+/// (the smallest for q = 0). `xs` is reordered; NaN when it holds a NaN or is empty.
+pub fn percentile(xs: &mut [f64], q: f64) -> f64 {
+    if xs.is_empty() || xs.iter().any(|x| x.is_nan()) || !(0.0..=1.0).contains(&q) {
+        return f64::NAN;
+    }
+    let rank = ((q * xs.len() as f64).ceil() as usize).clamp(1, xs.len());
+    let (_, x, _) = xs.select_nth_unstable_by(rank - 1, f64::total_cmp);
+    *x
+}
+
+/// `resamples` bootstrap resamples of `k` seeds: each a list of `k` indices drawn uniformly
+/// with replacement from 0..k, by Xoshiro256++ seeded with `seed` (the same on every machine
+/// and for every thread count). Empty for k = 0.
+pub fn bootstrap_indices(k: usize, resamples: usize, seed: u64) -> Vec<Vec<usize>> {
+    if k == 0 {
+        return Vec::new();
+    }
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    (0..resamples)
+        .map(|_| (0..k).map(|_| rng.random_range(0..k)).collect())
+        .collect()
 }
 
 /// Mean of `ys` and its standard error s/√K (`None` for fewer than two values).
@@ -214,6 +395,82 @@ fn register_font() -> Result<()> {
     } else {
         Err(Error::failed("the embedded font cannot be loaded"))
     }
+}
+
+/// The pieces of a label: plain runs and the subscripts written `_{…}`, in order, each with
+/// whether it is a subscript. Text without `_{` is one plain piece (an underscore alone is
+/// kept as it is, so names such as `my_run` are not mangled).
+fn pieces(label: &str) -> Vec<(&str, bool)> {
+    let mut out = Vec::new();
+    let mut rest = label;
+    while let Some(at) = rest.find("_{") {
+        let Some(close) = rest[at + 2..].find('}') else {
+            break;
+        };
+        if at > 0 {
+            out.push((&rest[..at], false));
+        }
+        out.push((&rest[at + 2..at + 2 + close], true));
+        rest = &rest[at + 3 + close..];
+    }
+    if !rest.is_empty() {
+        out.push((rest, false));
+    }
+    out
+}
+
+/// The label as plain text, its subscripts written inline (for widths and file formats
+/// without rich text).
+pub fn plain_label(label: &str) -> String {
+    pieces(label).into_iter().map(|(s, _)| s).collect()
+}
+
+/// Subscripts are drawn at this fraction of the text size, lowered by [`SUB_DROP`] of it.
+const SUB_SIZE: f64 = 0.7;
+const SUB_DROP: f64 = 0.35;
+
+/// Draws `label` with its subscripts, text of `size` pixels, its top left corner at `at`;
+/// returns the width drawn.
+fn draw_rich<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    label: &str,
+    at: (i32, i32),
+    size: f64,
+    colour: &RGBColor,
+) -> Result<i32, String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let mut x = at.0;
+    for (text, sub) in pieces(label) {
+        let (s, dy) = if sub {
+            (size * SUB_SIZE, (size * SUB_DROP).round() as i32)
+        } else {
+            (size, 0)
+        };
+        let font = (FAMILY, s).into_font().color(colour);
+        area.draw(&Text::new(text.to_owned(), (x, at.1 + dy), font.clone()))
+            .map_err(e)?;
+        let (w, _) = area.estimate_text_size(text, &font).map_err(e)?;
+        x += w as i32;
+    }
+    Ok(x - at.0)
+}
+
+/// Width in pixels of `label` drawn by [`draw_rich`] at `size`.
+fn rich_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    label: &str,
+    size: f64,
+) -> Result<i32, String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let mut w = 0;
+    for (text, sub) in pieces(label) {
+        let s = if sub { size * SUB_SIZE } else { size };
+        let (tw, _) = area
+            .estimate_text_size(text, &TextStyle::from((FAMILY, s).into_font()))
+            .map_err(e)?;
+        w += tw as i32;
+    }
+    Ok(w)
 }
 
 fn range(panel: &Panel) -> (f64, f64, f64, f64) {
@@ -260,6 +517,57 @@ fn range(panel: &Panel) -> (f64, f64, f64, f64) {
     }
     let pad = 0.05 * (y1 - y0);
     (x0, x1, y0 - pad, y1 + pad)
+}
+
+/// Ticks of an axis over the data range [`x0`, `x1`] (x0 < x1): multiples of a round step
+/// (1, 2 or 5 times a power of ten) giving at most 7 ticks, from the last multiple at or
+/// below x0 to the first at or above x1, so that the last tick covers the data (data to
+/// 1,999 or 2,000 end on a 2,000 tick, not 1,500). Returns the axis range and the ticks.
+fn ticks(x0: f64, x1: f64) -> ((f64, f64), Vec<f64>) {
+    let span = x1 - x0;
+    if !(span.is_finite() && span > 0.0) {
+        return ((x0, x1), vec![x0]);
+    }
+    let mut step = 10f64.powf((span / 6.0).log10().floor());
+    for m in [1.0, 2.0, 5.0, 10.0, 20.0] {
+        let s = step * m;
+        if ((x1 / s).ceil() - (x0 / s).floor()) <= 6.0 {
+            step = s;
+            break;
+        }
+    }
+    let a = (x0 / step).floor();
+    let b = (x1 / step).ceil();
+    let n = (b - a).round() as i64;
+    let ticks = (0..=n).map(|i| (a + i as f64) * step).collect();
+    (((a * step), (b * step)), ticks)
+}
+
+/// A linear axis whose ticks are given (see [`ticks`]).
+struct TickedAxis {
+    inner: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Ranged for TickedAxis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
 }
 
 /// The label of tick value `v` on an axis spanning `span`: a value within 10⁻⁹·span of 0 is
@@ -355,20 +663,26 @@ struct Layout {
     /// Panel grid (rows, columns).
     rows: u32,
     columns: u32,
+    /// Width and height of one panel.
+    panel_w: u32,
+    panel_h: u32,
     /// Left edge of the legend column, right of every panel.
     legend_x: u32,
 }
 
+/// Panel size, title band and legend row height at 100 dpi and 12 pt.
 const PANEL_W: u32 = 520;
 const PANEL_H: u32 = 400;
 const TITLE_H: u32 = 60;
 const LEGEND_ROW: u32 = 20;
 
-/// One entry of the legend: a label, its colour and whether it is a dashed reference line.
+/// One entry of the legend: a label, its colour and, for a reference line, its dash length
+/// and gap (at 100 dpi).
+#[derive(Debug, Clone, PartialEq)]
 struct Entry {
     label: String,
     colour: RGBColor,
-    dashed: bool,
+    dash: Option<(u32, u32)>,
 }
 
 /// The panels that have something to show.
@@ -384,7 +698,8 @@ fn shown(fig: &Figure) -> Vec<&Panel> {
 }
 
 /// The legend entries of `fig`: every series label once, in order of first appearance, then
-/// every reference line once. A label keeps its colour in every panel.
+/// every reference line once, each with its own colour and dash pattern. A label keeps its
+/// colour in every panel.
 fn legend(fig: &Figure) -> Vec<Entry> {
     let mut labels: Vec<&str> = Vec::new();
     for s in fig.panels.iter().flat_map(|p| &p.series) {
@@ -399,39 +714,51 @@ fn legend(fig: &Figure) -> Vec<Entry> {
         .map(|(i, l)| Entry {
             label: (*l).to_owned(),
             colour: colour(i, n),
-            dashed: false,
+            dash: None,
         })
         .collect();
+    let mut references = 0;
     for (l, _) in fig.panels.iter().flat_map(|p| &p.hlines) {
-        if !out.iter().any(|e| e.dashed && e.label == *l) {
+        if !out.iter().any(|e| e.dash.is_some() && e.label == *l) {
+            let (colour, dash, gap) = REFERENCE_STYLES[references % REFERENCE_STYLES.len()];
+            // Past the listed styles, lengthen the dash so that no two entries coincide.
+            let longer = 4 * (references / REFERENCE_STYLES.len()) as u32;
+            references += 1;
             out.push(Entry {
                 label: l.clone(),
-                colour: BLACK,
-                dashed: true,
+                colour,
+                dash: Some((dash + longer, gap)),
             });
         }
     }
     out
 }
 
-fn layout(fig: &Figure) -> Layout {
+fn layout(fig: &Figure, style: &Style) -> Layout {
     let n = shown(fig).len().max(1) as u32;
     let columns = (fig.columns.max(1) as u32).min(n);
     let rows = n.div_ceil(columns);
     let entries = legend(fig);
     let chars = entries
         .iter()
-        .map(|e| e.label.chars().count())
+        .map(|e| plain_label(&e.label).chars().count())
         .max()
-        .unwrap_or(0) as u32;
-    let legend_w = 50 + 7 * chars.max(8);
-    let legend_h = TITLE_H + 20 + LEGEND_ROW * entries.len() as u32;
+        .unwrap_or(0) as f64;
+    let fs = style.font_size / 12.0;
+    let panel_w = style.len(f64::from(PANEL_W) * fs.max(1.0));
+    let panel_h = style.len(f64::from(PANEL_H) * fs.max(1.0));
+    let legend_w = style.len(50.0 + 7.0 * fs * chars.max(8.0));
+    let title_h = style.len(f64::from(TITLE_H) * fs);
+    let legend_h =
+        title_h + style.len(20.0) + style.len(f64::from(LEGEND_ROW) * fs) * entries.len() as u32;
     Layout {
-        width: PANEL_W * columns + legend_w,
-        height: (TITLE_H + PANEL_H * rows).max(legend_h),
+        width: panel_w * columns + legend_w,
+        height: (title_h + panel_h * rows).max(legend_h),
         rows,
         columns,
-        legend_x: PANEL_W * columns,
+        panel_w,
+        panel_h,
+        legend_x: panel_w * columns,
     }
 }
 
@@ -440,7 +767,7 @@ fn layout(fig: &Figure) -> Layout {
 enum Pen {
     /// One polyline of width 2 (SVG: the viewer joins the segments).
     Stroke,
-    /// Three polylines of width 1, offset by a pixel right and up (bitmaps: plotters fills a
+    /// Polylines of width 1, offset by a pixel right and up (bitmaps: plotters fills a
     /// wider polyline as one polygon whose joins at sharp turns spike far beyond the data).
     Pixels,
 }
@@ -449,48 +776,77 @@ fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &Figure,
     pen: Pen,
+    style: &Style,
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    let lay = layout(fig);
+    let lay = layout(fig, style);
     root.fill(&WHITE).map_err(e)?;
-    let area = root.titled(&fig.title, (FAMILY, 22)).map_err(e)?;
+    let area = root
+        .titled(
+            &plain_label(&fig.title),
+            (FAMILY, style.text(22.0)).into_font(),
+        )
+        .map_err(e)?;
     let (panels_area, legend_area) = area.split_horizontally(lay.legend_x);
-    let panels_area = panels_area.shrink((0, 0), (lay.legend_x, PANEL_H * lay.rows));
+    let panels_area = panels_area.shrink((0, 0), (lay.legend_x, lay.panel_h * lay.rows));
     let entries = legend(fig);
     let cells = panels_area.split_evenly((lay.rows as usize, lay.columns as usize));
     for (cell, panel) in cells.iter().zip(shown(fig)) {
-        draw_panel(cell, panel, &entries, pen)?;
+        draw_panel(cell, panel, &entries, pen, style)?;
     }
-    draw_legend(&legend_area, &entries)?;
+    draw_legend(&legend_area, &entries, style)?;
     root.present().map_err(e)
+}
+
+/// The points of a dashed segment from `x0` to `x1` at height `y`: dashes of `dash` pixels
+/// separated by `gap`.
+fn dashes(x0: i32, x1: i32, y: i32, (dash, gap): (i32, i32)) -> Vec<[(i32, i32); 2]> {
+    let mut out = Vec::new();
+    let mut x = x0;
+    while x < x1 {
+        out.push([(x, y), ((x + dash).min(x1), y)]);
+        x += dash + gap;
+    }
+    out
 }
 
 fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[Entry],
+    style: &Style,
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    let font = (FAMILY, 13).into_font().color(&BLACK);
+    let size = style.text(13.0);
+    let row = style.len(f64::from(LEGEND_ROW) * style.font_size / 12.0) as i32;
+    let len = |x: f64| style.len(x) as i32;
     for (i, entry) in entries.iter().enumerate() {
-        let y = 30 + LEGEND_ROW as i32 * i as i32;
-        let line = vec![(10, y), (38, y)];
-        if entry.dashed {
-            area.draw(&PathElement::new(
-                vec![(10, y), (20, y)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(e)?;
-            area.draw(&PathElement::new(
-                vec![(28, y), (38, y)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(e)?;
-        } else {
-            area.draw(&PathElement::new(line, entry.colour.stroke_width(3)))
+        let y = len(30.0) + row * i as i32;
+        match entry.dash {
+            Some((dash, gap)) => {
+                let pattern = (len(f64::from(dash)), len(f64::from(gap)));
+                for seg in dashes(len(8.0), len(40.0), y, pattern) {
+                    area.draw(&PathElement::new(
+                        seg.to_vec(),
+                        entry.colour.stroke_width(style.len(1.5)),
+                    ))
+                    .map_err(e)?;
+                }
+            }
+            None => {
+                area.draw(&PathElement::new(
+                    vec![(len(10.0), y), (len(38.0), y)],
+                    entry.colour.stroke_width(style.len(3.0)),
+                ))
                 .map_err(e)?;
+            }
         }
-        area.draw(&Text::new(entry.label.as_str(), (46, y - 7), font.clone()))
-            .map_err(e)?;
+        draw_rich(
+            area,
+            &entry.label,
+            (len(46.0), y - (size / 2.0).round() as i32),
+            size,
+            &BLACK,
+        )?;
     }
     Ok(())
 }
@@ -509,23 +865,43 @@ fn draw_panel<DB: DrawingBackend>(
     panel: &Panel,
     entries: &[Entry],
     pen: Pen,
+    style: &Style,
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let (x0, x1, y0, y1) = range(panel);
-    let mut chart = ChartBuilder::on(cell)
-        .caption(&panel.title, (FAMILY, 16))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
+    let ((x0, x1), x_ticks) = ticks(x0, x1);
+    // The caption, drawn with its subscripts, centred above the chart.
+    let caption = style.text(16.0);
+    let caption_h = (caption * 1.6).round() as u32;
+    let (top, chart_area) = cell.split_vertically(caption_h);
+    let width = rich_width(&top, &panel.title, caption)?;
+    let (w, _) = top.dim_in_pixel();
+    let left = ((w as i32 - width) / 2).max(0);
+    draw_rich(
+        &top,
+        &panel.title,
+        (left, (caption * 0.4).round() as i32),
+        caption,
+        &BLACK,
+    )?;
+    let mut chart = ChartBuilder::on(&chart_area)
+        .margin(style.len(10.0))
+        .x_label_area_size(style.len(40.0 * style.font_size / 12.0))
+        .y_label_area_size(style.len(70.0 * style.font_size / 12.0))
+        .build_cartesian_2d(
+            TickedAxis {
+                inner: (x0..x1).into(),
+                ticks: x_ticks,
+            },
+            y0..y1,
+        )
         .map_err(e)?;
     chart
         .configure_mesh()
         .x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
-        .label_style((FAMILY, 12))
-        .axis_desc_style((FAMILY, 13))
-        .x_labels(6)
+        .label_style((FAMILY, style.text(12.0)))
+        .axis_desc_style((FAMILY, style.text(13.0)))
         .y_labels(6)
         .x_label_formatter(&|v| tick(*v, x1 - x0))
         .y_label_formatter(&|v| tick(*v, y1 - y0))
@@ -535,7 +911,7 @@ fn draw_panel<DB: DrawingBackend>(
     for s in &panel.series {
         let colour = entries
             .iter()
-            .find(|en| !en.dashed && en.label == s.label)
+            .find(|en| en.dash.is_none() && en.label == s.label)
             .map_or(BLACK, |en| en.colour);
         if let Some((lo, hi)) = &s.band {
             let mut poly = decimate(&s.x, hi, Pick::Max);
@@ -551,14 +927,24 @@ fn draw_panel<DB: DrawingBackend>(
         match pen {
             Pen::Stroke => {
                 chart
-                    .draw_series(LineSeries::new(points, colour.stroke_width(2)))
+                    .draw_series(LineSeries::new(points, colour.stroke_width(style.len(2.0))))
                     .map_err(e)?;
             }
             Pen::Pixels => {
                 let (w, h) = chart.plotting_area().dim_in_pixel();
                 let dx = (x1 - x0) / f64::from(w.max(1));
                 let dy = (y1 - y0) / f64::from(h.max(1));
-                for (ox, oy) in [(0.0, 0.0), (dx, 0.0), (0.0, dy)] {
+                let thick = style.len(2.0) as i32 - 1;
+                let offsets = (0..=thick).flat_map(|i| {
+                    let i = f64::from(i);
+                    [(i * dx, 0.0), (0.0, i * dy)]
+                });
+                let mut seen = Vec::new();
+                for (ox, oy) in offsets {
+                    if seen.contains(&(ox, oy)) {
+                        continue;
+                    }
+                    seen.push((ox, oy));
                     let shifted = points.iter().map(|&(x, y)| (x + ox, y + oy));
                     chart
                         .draw_series(LineSeries::new(shifted, colour.stroke_width(1)))
@@ -567,38 +953,47 @@ fn draw_panel<DB: DrawingBackend>(
             }
         }
     }
-    for (_, y) in &panel.hlines {
+    for (label, y) in &panel.hlines {
+        let Some(entry) = entries
+            .iter()
+            .find(|en| en.dash.is_some() && en.label == *label)
+        else {
+            continue;
+        };
+        let (dash, gap) = entry.dash.unwrap_or((6, 4));
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(x0, *y), (x1, *y)],
-                6,
-                4,
-                BLACK.stroke_width(1),
+                style.len(f64::from(dash)),
+                style.len(f64::from(gap)),
+                entry.colour.stroke_width(style.len(1.5)),
             ))
             .map_err(e)?;
     }
     Ok(())
 }
 
-fn size(fig: &Figure) -> (u32, u32) {
-    let lay = layout(fig);
+fn size(fig: &Figure, style: &Style) -> (u32, u32) {
+    let lay = layout(fig, style);
     (lay.width, lay.height)
 }
 
-/// Writes `fig` to `path`, as PNG or SVG by the extension, atomically (rendered to a
-/// temporary file in the same folder, then renamed).
+/// Writes `fig` to `path` in `style`, as PNG or SVG by the extension, atomically (rendered
+/// to a temporary file in the same folder, then renamed).
 ///
 /// # Errors
-/// [`Error::Invalid`] for another extension; [`Error::Failed`] when rendering or writing fails.
-pub fn save(fig: &Figure, path: &Path) -> Result<()> {
+/// [`Error::Invalid`] for another extension or a style out of its domain; [`Error::Failed`]
+/// when rendering or writing fails.
+pub fn save(fig: &Figure, path: &Path, style: &Style) -> Result<()> {
+    style.validate()?;
     register_font()?;
     let fail = |e: String| Error::failed(format!("cannot draw {}: {e}", path.display()));
     match path.extension().and_then(|e| e.to_str()) {
         Some("svg") => {
             let mut svg = String::new();
             {
-                let root = SVGBackend::with_string(&mut svg, size(fig)).into_drawing_area();
-                draw(&root, fig, Pen::Stroke).map_err(fail)?;
+                let root = SVGBackend::with_string(&mut svg, size(fig, style)).into_drawing_area();
+                draw(&root, fig, Pen::Stroke, style).map_err(fail)?;
             }
             write_atomic(path, svg.as_bytes())
         }
@@ -613,8 +1008,8 @@ pub fn save(fig: &Figure, path: &Path) -> Result<()> {
                 .tempfile_in(&dir)
                 .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
             {
-                let root = BitMapBackend::new(tmp.path(), size(fig)).into_drawing_area();
-                draw(&root, fig, Pen::Pixels).map_err(fail)?;
+                let root = BitMapBackend::new(tmp.path(), size(fig, style)).into_drawing_area();
+                draw(&root, fig, Pen::Pixels, style).map_err(fail)?;
             }
             tmp.persist(path).map_err(|e| {
                 Error::failed(format!("cannot write {}: {}", path.display(), e.error))
@@ -628,15 +1023,15 @@ pub fn save(fig: &Figure, path: &Path) -> Result<()> {
     }
 }
 
-/// Writes `fig` as `<stem>.png` and `<stem>.svg` in `dir`; returns the two paths.
+/// Writes `fig` as `<stem>.png` and `<stem>.svg` in `dir` in `style`; returns the two paths.
 ///
 /// # Errors
 /// As [`save`].
-pub fn save_both(fig: &Figure, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+pub fn save_both(fig: &Figure, dir: &Path, stem: &str, style: &Style) -> Result<[PathBuf; 2]> {
     let png = dir.join(format!("{stem}.png"));
     let svg = dir.join(format!("{stem}.svg"));
-    save(fig, &png)?;
-    save(fig, &svg)?;
+    save(fig, &png, style)?;
+    save(fig, &svg, style)?;
     Ok([png, svg])
 }
 
@@ -670,26 +1065,56 @@ mod tests {
     }
 
     #[test]
-    fn sigma_bands_are_clipped_at_zero() {
-        // Two seeds with σ = 0.001 and 0.021: the 95% t-interval, 0.011 ± 12.7 · 0.01, reaches
-        // −0.116; clipped at 0 its lower end is 0 and its upper end is unchanged.
+    fn sigma_bands_are_intervals_on_log_sigma() {
+        // Two seeds with σ = 0.001 and 0.021: the 95% t-interval on σ, 0.011 ± 12.7 · 0.01,
+        // reaches −0.116. On log σ: logs −6.9078 and −3.8632, mean −5.3855 (geometric mean
+        // √(0.001 · 0.021) = 0.0045826), s = 2.1528, half-width 12.706 · 2.1528/√2 = 19.342:
+        // the band is exp(−5.3855 ± 19.342), positive on both ends.
         let curves = vec![vec![0.001, 0.5], vec![0.021, 0.5]];
-        let (mean, band) = mean_band(&curves, BandKind::Ci95);
-        let (lo, hi) = band.clone().expect("two seeds");
-        assert!(lo[0] < -0.1, "{lo:?}");
-        let panel = Panel {
-            series: vec![Series {
-                label: "σ".into(),
-                x: vec![0.0, 1.0],
-                mean,
-                band,
-            }],
-            ..Panel::default()
-        }
-        .clipped_at(0.0);
-        let (clo, chi) = panel.series[0].band.clone().expect("band kept");
-        assert_eq!(clo, vec![0.0, 0.5]);
-        assert_eq!(chi, hi);
+        let (lo_lin, _) = mean_band(&curves, BandKind::Ci95).1.expect("two seeds");
+        assert!(lo_lin[0] < -0.1, "{lo_lin:?}");
+        let (mean, band) = mean_band_on(&curves, BandKind::Ci95, Scale::Log);
+        let (lo, hi) = band.expect("two seeds");
+        let g = (0.001f64 * 0.021).sqrt();
+        assert!((mean[0] - g).abs() < 1e-15, "{mean:?}");
+        let t1 = 12.706_204_736_174_7;
+        let s = (0.021f64.ln() - 0.001f64.ln()).abs() / 2f64.sqrt();
+        let h = t1 * s / 2f64.sqrt();
+        assert!((lo[0] / (g.ln() - h).exp() - 1.0).abs() < 1e-9, "{lo:?}");
+        assert!((hi[0] / (g.ln() + h).exp() - 1.0).abs() < 1e-9, "{hi:?}");
+        assert!(lo.iter().all(|&y| y > 0.0));
+        // Equal values: no spread, the band collapses on the value.
+        assert!((mean[1] - 0.5).abs() < 1e-15 && (lo[1] - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bootstrap_bands_stay_within_the_seeds() {
+        // Budgets of five seeds, four at 0 and one far below: the t-interval's lower end
+        // (mean −20, s = 44.72, t(0.975, 4) = 2.7764: −20 − 55.5 = −75.5) is below every
+        // seed's value; a percentile bootstrap interval of the mean lies between the smallest
+        // and the largest mean of a resample, here in [−100, 0].
+        let curves: Vec<Vec<f64>> = [0.0, 0.0, 0.0, 0.0, -100.0]
+            .iter()
+            .map(|&b| vec![b])
+            .collect();
+        let (lo_t, _) = mean_band(&curves, BandKind::Ci95).1.expect("band");
+        assert!(lo_t[0] < -75.0, "{lo_t:?}");
+        let (mean, band) = mean_band_on(&curves, BandKind::Ci95, Scale::Bootstrap);
+        let (lo, hi) = band.expect("band");
+        assert_eq!(mean, vec![-20.0]);
+        assert!(lo[0] >= -100.0 && hi[0] <= 0.0, "{lo:?} {hi:?}");
+        // The number of resampled −100s is Binomial(5, 1/5): the mean is −20·j with
+        // P(j = 0) = 0.32768 > 2.5%, so the upper 97.5% percentile is 0; P(j ≥ 3) =
+        // 0.05792 > 2.5% and P(j ≥ 4) = 0.00672, so the lower 2.5% percentile is −60 (with
+        // 2,000 resamples the estimated tails are within 4.4 standard errors, 0.026 and
+        // 0.0081, of these).
+        assert_eq!(hi[0], 0.0);
+        assert_eq!(lo[0], -60.0);
+        // Same seed, same band.
+        assert_eq!(
+            mean_band_on(&curves, BandKind::Ci95, Scale::Bootstrap).1,
+            Some((lo, hi))
+        );
     }
 
     /// CIE L*a*b* of an sRGB colour (D65 white), for perceptual distances.
@@ -782,10 +1207,10 @@ mod tests {
         let fig = big_figure(16, 10_001);
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("f.svg");
-        save(&fig, &path).expect("drawn");
+        save(&fig, &path, &Style::default()).expect("drawn");
         let svg = std::fs::read_to_string(&path).expect("read");
         assert!(svg.len() < 1_000_000, "{} bytes", svg.len());
-        let lay = layout(&fig);
+        let lay = layout(&fig, &Style::default());
         assert_eq!((lay.rows, lay.columns, lay.legend_x), (2, 2, 2 * PANEL_W));
         // Every legend label is a text element whose x lies right of the last panel column.
         for g in 0..16 {
@@ -876,14 +1301,20 @@ mod tests {
             columns: 1,
         };
         register_font().expect("font");
-        let (w, h) = size(&fig);
+        let style = Style::default();
+        let (w, h) = size(&fig, &style);
         let mut buf = vec![0u8; (w * h * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-            draw(&root, &fig, Pen::Pixels).expect("drawn");
+            draw(&root, &fig, Pen::Pixels, &style).expect("drawn");
         }
         // Left of the legend (whose sample line has the series' colour).
-        let curve = rows_with(&buf, w as usize, layout(&fig).legend_x as usize, PALETTE[0]);
+        let curve = rows_with(
+            &buf,
+            w as usize,
+            layout(&fig, &style).legend_x as usize,
+            PALETTE[0],
+        );
         let (top, bottom) = (
             *curve.first().expect("drawn"),
             *curve.last().expect("drawn"),
@@ -901,7 +1332,165 @@ mod tests {
         fig.panels[1].series.clear();
         fig.columns = 3;
         assert_eq!(shown(&fig).len(), 3);
-        let lay = layout(&fig);
+        let lay = layout(&fig, &Style::default());
         assert_eq!((lay.rows, lay.columns), (1, 3));
+    }
+
+    /// A figure with the three reference lines of Figure 5.2 (v*, J_B, B = 0) in three panels
+    /// and math labels in its captions and legend.
+    fn reference_figure() -> Figure {
+        let series = |label: &str| Series {
+            label: label.into(),
+            x: (0..2000).map(f64::from).collect(),
+            mean: (0..2000).map(|i| f64::from(i).sqrt()).collect(),
+            band: None,
+        };
+        let panel = |title: &str, hline: &str| Panel {
+            title: title.into(),
+            x_label: "iteration".into(),
+            y_label: "J".into(),
+            series: vec![series("SEPG-MI"), series("J(θ_{T})")],
+            hlines: vec![(hline.into(), 1.0)],
+        };
+        Figure {
+            title: "references".into(),
+            panels: vec![
+                panel("(c) mean parameter v", "v*"),
+                panel("(d) mean of (J_{E} + J_{T})/2", "J_{B} = J(θ⁰)"),
+                panel("(f) budget", "B = 0"),
+            ],
+            columns: 3,
+        }
+    }
+
+    #[test]
+    fn reference_lines_have_distinct_legend_entries() {
+        let entries = legend(&reference_figure());
+        let refs: Vec<&Entry> = entries.iter().filter(|e| e.dash.is_some()).collect();
+        assert_eq!(refs.len(), 3);
+        for (i, a) in refs.iter().enumerate() {
+            assert!(!PALETTE.contains(&a.colour), "{a:?}");
+            for b in &refs[..i] {
+                assert_ne!(a.colour, b.colour, "{a:?} {b:?}");
+                assert_ne!(a.dash, b.dash, "{a:?} {b:?}");
+            }
+        }
+        // Many reference lines: still pairwise distinct.
+        let mut fig = reference_figure();
+        fig.panels[0].hlines = (0..7).map(|i| (format!("r{i}"), 0.0)).collect();
+        let entries = legend(&fig);
+        for (i, a) in entries.iter().enumerate() {
+            for b in &entries[..i] {
+                assert!((a.colour, a.dash) != (b.colour, b.dash), "{a:?} {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn subscripts_are_parsed_and_drawn_without_markup() {
+        assert_eq!(pieces("J_{E}"), vec![("J", false), ("E", true)]);
+        assert_eq!(
+            pieces("(J_{E} + J_{T})/2"),
+            vec![
+                ("(J", false),
+                ("E", true),
+                (" + J", false),
+                ("T", true),
+                (")/2", false)
+            ]
+        );
+        assert_eq!(pieces("my_run"), vec![("my_run", false)]);
+        assert_eq!(plain_label("θ_{E}"), "θE");
+        // In the SVG, no text element shows the markup or a raw underscore, and the
+        // subscript is a text element of its own, smaller than the text it follows.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.svg");
+        save(&reference_figure(), &path, &Style::default()).expect("drawn");
+        let svg = std::fs::read_to_string(&path).expect("read");
+        assert!(!svg.contains("_{") && !svg.contains("J_"), "markup drawn");
+        assert!(svg.contains(">\n(d) mean of (J\n</text>"), "caption split");
+        assert!(svg.contains(">\nE\n</text>"), "subscript drawn");
+    }
+
+    #[test]
+    fn the_last_x_tick_covers_the_data() {
+        // Iterations 0..1999: the ticks end at 2,000, not 1,500.
+        let ((a, b), t) = ticks(0.0, 1999.0);
+        assert_eq!((a, b), (0.0, 2000.0));
+        assert_eq!(t, vec![0.0, 500.0, 1000.0, 1500.0, 2000.0]);
+        for (x0, x1) in [
+            (0.0, 9999.0),
+            (3.0, 17.0),
+            (-0.7, 0.1),
+            (0.0, 2.4e7),
+            (5.0, 5.5),
+        ] {
+            let ((a, b), t) = ticks(x0, x1);
+            assert!(a <= x0 && b >= x1, "{x0} {x1}: {a} {b}");
+            assert_eq!((t[0], *t.last().expect("ticks")), (a, b));
+            assert!(t.len() >= 2 && t.len() <= 7, "{x0} {x1}: {t:?}");
+        }
+        // Drawn: the 2,000 tick label is in the SVG.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.svg");
+        save(&reference_figure(), &path, &Style::default()).expect("drawn");
+        let svg = std::fs::read_to_string(&path).expect("read");
+        assert!(svg.contains(">\n2000\n</text>"), "no 2000 tick");
+    }
+
+    #[test]
+    fn dpi_scales_the_image_and_font_size_the_text() {
+        let fig = reference_figure();
+        let base = size(&fig, &Style::default());
+        let double = size(
+            &fig,
+            &Style {
+                dpi: 200,
+                ..Style::default()
+            },
+        );
+        assert_eq!(double, (2 * base.0, 2 * base.1));
+        let big = Style {
+            font_size: 24.0,
+            ..Style::default()
+        };
+        assert_eq!(big.text(12.0), 24.0);
+        assert!(size(&fig, &big).0 > base.0);
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.png");
+        save(
+            &fig,
+            &path,
+            &Style {
+                dpi: 150,
+                ..Style::default()
+            },
+        )
+        .expect("drawn");
+        let png = std::fs::read(&path).expect("read");
+        // The PNG header's IHDR chunk: width and height, big-endian, at bytes 16..24.
+        let w = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+        let h = u32::from_be_bytes([png[20], png[21], png[22], png[23]]);
+        let expect = size(
+            &fig,
+            &Style {
+                dpi: 150,
+                ..Style::default()
+            },
+        );
+        assert_eq!((w, h), expect);
+        assert!((w as f64 / base.0 as f64 - 1.5).abs() < 0.01);
+        for bad in [
+            Style {
+                dpi: 10,
+                ..Style::default()
+            },
+            Style {
+                font_size: f64::NAN,
+                ..Style::default()
+            },
+        ] {
+            assert!(save(&fig, &path, &bad).is_err());
+        }
     }
 }
