@@ -27,6 +27,7 @@ pub mod estimate;
 pub mod exact;
 pub mod figure;
 pub mod folder;
+pub mod logcheck;
 pub mod merge;
 pub mod report;
 pub mod reproduce;
