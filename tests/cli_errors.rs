@@ -396,3 +396,95 @@ fn walk_logs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     }
     found
 }
+
+/// Ctrl-C in the middle of a long iteration (an exact-gradient run on the clipped `lqg1d` at
+/// the largest horizon, whose dynamic programme takes seconds per iteration) stops the run
+/// inside that iteration: it exits with one line naming `--resume` and the checkpoint of
+/// iteration 0, not after finishing the iteration; resumed, it gives the uninterrupted log.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let args = |dir: &std::path::Path| {
+        [
+            "run",
+            "--env",
+            "lqg1d",
+            "--gradients",
+            "exact",
+            "--horizon",
+            "100000",
+            "--iterations",
+            "1",
+            "--quiet",
+            "--out",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([dir.display().to_string()])
+        .collect::<Vec<_>>()
+    };
+    let dir = tmp.path().join("interrupted");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(args(&dir))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // The handler is in place once the configuration is written (it is installed before the
+    // folder is created); iteration 0 then runs for seconds.
+    let start = Instant::now();
+    while !dir.join("config.toml").exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the run never started"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let sent = Instant::now();
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(kill.success());
+    // A liveness bound, not a speed measurement: generous for a loaded machine.
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        if sent.elapsed() > Duration::from_secs(10) {
+            let _ = child.kill();
+            panic!("the run ignored Ctrl-C for 10 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().expect("stderr"), &mut err)
+        .expect("stderr");
+    assert_eq!(status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err:?}");
+    assert!(
+        err.contains("interrupted after iteration 0 of 1") && err.contains("--resume"),
+        "{err}"
+    );
+    assert!(!dir.join("summary.json").exists());
+    let resumed = sepg(&["run", "--resume", &dir.display().to_string(), "--quiet"]);
+    assert_eq!(
+        resumed.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let reference = tmp.path().join("reference");
+    let refs: Vec<String> = args(&reference);
+    let refs: Vec<&str> = refs.iter().map(String::as_str).collect();
+    assert_eq!(sepg(&refs).status.code(), Some(0));
+    assert_eq!(
+        std::fs::read(dir.join("log.csv")).expect("log"),
+        std::fs::read(reference.join("log.csv")).expect("reference log")
+    );
+}

@@ -10,6 +10,7 @@
 //! - [`monte_carlo`]: Monte Carlo estimates of `J` and of paired differences of `J`.
 //! - [`oracle`]: exact LQG oracles.
 pub mod batch;
+pub mod cancel;
 pub mod env;
 pub mod features;
 pub mod lqg_model;

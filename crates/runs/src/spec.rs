@@ -788,14 +788,13 @@ impl RunSpec {
             )));
         }
         check_batch_memory("batch", schedule.batch, schedule.horizon, (dim_v, dim_w))?;
-        if gradients == GradientsName::Sampled {
-            let reference = self.reference_batch.unwrap_or(0);
-            check_batch_memory(
-                "reference-batch",
-                reference,
-                schedule.horizon,
-                (dim_v, dim_w),
-            )?;
+        // The reference batch keeps one return (8 bytes) per trajectory.
+        let reference = self.reference_batch.unwrap_or(0) as u64;
+        if reference.checked_mul(8).is_none_or(|b| b > MAX_BATCH_BYTES) {
+            return Err(Error::invalid(format!(
+                "reference-batch N = {reference} returns need more than the limit of {} GiB",
+                MAX_BATCH_BYTES >> 30
+            )));
         }
         let feature_dim = env.feature_dim();
         let config = SepgConfig {
