@@ -1517,6 +1517,49 @@ impl Resolved {
 mod tests {
     use super::*;
 
+    fn lqg1d(f: impl FnOnce(&mut RunSpec)) -> Result<Resolved> {
+        let mut spec = RunSpec {
+            env: Some(EnvName::Lqg1d),
+            iterations: Some(1),
+            ..RunSpec::default()
+        };
+        f(&mut spec);
+        spec.resolve()
+    }
+
+    #[test]
+    fn sizes_are_refused_at_resolution_exactly_above_their_limits() {
+        // lqg1d, H = 20, one parameter of each kind: (20 · 3 + 1) · 8 = 488 bytes per
+        // trajectory; 8 GiB = 8,589,934,592 bytes hold 17,602,324 of them
+        // (8,589,934,112 bytes), one more needs 8,589,934,600.
+        assert!(lqg1d(|s| s.batch = Some(17_602_324)).is_ok());
+        let e = lqg1d(|s| s.batch = Some(17_602_325)).expect_err("too large");
+        assert!(e.is_invalid_input(), "{e}");
+        let e = lqg1d(|s| s.batch = Some(usize::MAX)).expect_err("overflow");
+        assert!(e.to_string().contains("more than 2^64 bytes"), "{e}");
+        assert!(lqg1d(|s| s.horizon = Some(MAX_HORIZON)).is_ok());
+        let e = lqg1d(|s| s.horizon = Some(MAX_HORIZON + 1)).expect_err("horizon");
+        assert!(e.is_invalid_input(), "{e}");
+        let e = lqg1d(|s| s.iterations = Some(MAX_ITERATIONS + 1)).expect_err("iterations");
+        assert!(e.is_invalid_input(), "{e}");
+        // 2^30 returns of 8 bytes are exactly 8 GiB.
+        assert!(lqg1d(|s| s.reference_batch = Some(1 << 30)).is_ok());
+        assert!(lqg1d(|s| s.reference_batch = Some((1 << 30) + 1)).is_err());
+    }
+
+    #[test]
+    fn an_initial_policy_the_policy_cannot_represent_is_refused_at_resolution() {
+        // w = ln σ must satisfy |w| < 354: ln(1e153) = 352.3 passes, ln(1e154) = 354.6 not.
+        assert!(lqg1d(|s| s.sigma0 = Some(Values::One(1e153))).is_ok());
+        for sigma in [1e154, 1e300, 1e-154] {
+            let e = lqg1d(|s| s.sigma0 = Some(Values::One(sigma))).expect_err("refused");
+            assert!(
+                e.is_invalid_input() && e.to_string().contains("sigma0"),
+                "{e}"
+            );
+        }
+    }
+
     #[test]
     fn resolving_a_resolved_configuration_changes_nothing() {
         let spec = RunSpec {
