@@ -200,6 +200,26 @@ fn a_batch_that_cannot_fit_in_memory_is_refused_before_any_folder() {
     ]));
     assert!(line.contains("GiB"), "{line}");
     assert!(!sweep.exists());
+    // 10¹¹ seeds of one preset, variant and σ⁰: 10¹¹ runs, above the limit of 10⁶.
+    std::fs::write(
+        &file,
+        "presets = [\"lqg1d\"]\nseeds = 100000000000\nsigma0 = [1.0]\n[base]\niterations = 1\n\
+         batch = 12\n[[variant]]\nname = \"zv\"\nalgo = \"sepg-zv\"\n",
+    )
+    .expect("write");
+    let line = assert_usage_error(&sepg(&[
+        "sweep",
+        "--config",
+        &file.display().to_string(),
+        "--out",
+        &sweep.display().to_string(),
+        "--quiet",
+    ]));
+    assert!(
+        line.contains("100000000000 runs") && line.contains("1000000"),
+        "{line}"
+    );
+    assert!(!sweep.exists());
 }
 
 #[test]
