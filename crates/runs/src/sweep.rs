@@ -281,7 +281,7 @@ fn resolve_run(
     };
     base.overlay(variant).overlay(&axes).resolve().map_err(|e| {
         Error::invalid(format!(
-            "variant {name} on {} with sigma0 {sigma0}: {e}",
+            "variant {name} on {} with sigma0 {sigma0:?}: {e}",
             preset.name()
         ))
     })
