@@ -15,7 +15,10 @@
 //! produces the same rows, bit for bit, as an uninterrupted one.
 //!
 //! A run stops early, after checkpointing, when its stop flag is raised (the command line
-//! raises it on Ctrl-C); it reports its progress to an [`Observer`].
+//! raises it on Ctrl-C): after the current iteration, or inside it when the process-wide
+//! cancellation request of `sepg_mdp::cancel` is raised too (the iteration's rollouts or
+//! dynamic programme then fail at once, its work is discarded and the checkpoint is that of
+//! the last completed iteration). It reports its progress to an [`Observer`].
 
 use std::fs::{self, File, OpenOptions};
 use std::io::Write;
