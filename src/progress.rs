@@ -9,16 +9,29 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sepg_runs::run::Observer;
 
 /// Raised by SIGINT or SIGTERM (what cluster schedulers send before killing a job): every
-/// running loop stops after its current iteration and checkpoints.
+/// running loop stops, within its current chunk of trajectories or step of a dynamic
+/// programme, and checkpoints the last completed iteration.
 pub static STOP: AtomicBool = AtomicBool::new(false);
 
-/// Installs the SIGINT and SIGTERM handler that raises [`STOP`] (once per process).
+/// Exit status after a second SIGINT or SIGTERM (128 + SIGINT, as shells report Ctrl-C).
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// Installs the SIGINT and SIGTERM handler (once per process). The first signal raises
+/// [`STOP`] and the cancellation request of the rollouts and dynamic programmes
+/// ([`sepg_mdp::cancel`]); a second one ends the process at once with status
+/// [`EXIT_INTERRUPTED`]. Every file of a run folder is replaced atomically and the partial log
+/// is cut back to its checkpoint on resume, so the folder stays resumable either way.
 pub fn install_interrupt_handler() {
     static ONCE: OnceLock<()> = OnceLock::new();
     ONCE.get_or_init(|| {
         // Without a handler (e.g. one is already installed) the signals keep their default
         // action; the checkpoints still leave the folder consistent.
-        let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::SeqCst));
+        let _ = ctrlc::set_handler(|| {
+            if STOP.swap(true, Ordering::SeqCst) {
+                std::process::exit(EXIT_INTERRUPTED);
+            }
+            sepg_mdp::cancel::request();
+        });
     });
 }
 

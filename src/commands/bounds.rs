@@ -10,7 +10,7 @@ use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use sepg_bounds::{BoundsError, batch_size, papini, pirotta, surrogate, v_update, w_update};
 use sepg_certified::Interval;
 use sepg_certified::{self as certified, Certified, Quadratic};
-use sepg_runs::spec::{ConstantsName, RewardsName};
+use sepg_runs::spec::{ConstantsName, MAX_HORIZON, RewardsName};
 use serde::Serialize;
 
 use crate::cli::CliError;
@@ -355,9 +355,13 @@ fn fill_batch(r: &mut BoundsReport, a: &BoundsArgs, k: &TaskConstants) -> Result
     match (a.delta, a.eps, a.horizon) {
         (Some(delta), Some(eps), Some(horizon)) => {
             let h = match horizon {
-                Horizon::Finite(h) => u32::try_from(h).map_err(|_| {
-                    CliError::usage(format!("batch sizes need --horizon at most {}", u32::MAX))
-                })?,
+                // The batch sizes sum H terms: the limit keeps them under a second.
+                Horizon::Finite(h) if h <= MAX_HORIZON as u64 => h as u32,
+                Horizon::Finite(_) => {
+                    return Err(CliError::usage(format!(
+                        "batch sizes need --horizon at most {MAX_HORIZON}"
+                    )));
+                }
                 Horizon::Infinite => {
                     return Err(CliError::usage("batch sizes need a finite --horizon"));
                 }

@@ -27,8 +27,10 @@ pub struct MergeArgs {
 /// Runs `sepg merge`.
 ///
 /// # Errors
-/// Usage error (exit 2) for folders that are not complete shards of one sweep or a non-empty
-/// output folder; failure (exit 1) for I/O errors.
+/// Usage error (exit 2) for folders that are not complete shards of one sweep, a run whose
+/// log `sepg audit` would refuse (cut, NaN, missing rows; the line names the log file and its
+/// first bad line), or an output folder that is not empty or cannot be written; failure
+/// (exit 1) for I/O errors while copying.
 pub fn run(args: &MergeArgs) -> Result<(), CliError> {
     let merged = sepg_runs::merge::merge(&args.shards, &args.out, args.force)?;
     if !args.quiet {

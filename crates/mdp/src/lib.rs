@@ -13,6 +13,7 @@
 #![deny(missing_docs)]
 
 pub mod batch;
+pub mod cancel;
 pub mod env;
 pub mod features;
 pub mod lqg_model;

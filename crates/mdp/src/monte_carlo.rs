@@ -304,6 +304,9 @@ where
     let items = n.div_ceil(BLOCK);
     let mut round = Vec::with_capacity(ROUND);
     for start in (0..items).step_by(ROUND) {
+        if crate::cancel::requested() {
+            return Err(McError::Rollout(RolloutError::Cancelled));
+        }
         (start..items.min(start + ROUND))
             .into_par_iter()
             .map_init(

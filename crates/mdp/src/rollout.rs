@@ -93,6 +93,9 @@ pub enum RolloutError {
     /// parameters on an unclipped environment).
     #[error("a reward, score or return is not finite (diverging dynamics or overflow)")]
     NonFinite,
+    /// The computation was cancelled ([`crate::cancel::request`]) before it completed.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 /// Rolls out `n` trajectories of at most `horizon` steps with the stochastic `policy` and
@@ -225,7 +228,9 @@ pub fn rollout_into_with<E: Environment + ?Sized>(
             (len, finite_trajectory(g, &sc.cum_v, &sc.cum_w))
         })
     };
-    if finite {
+    if crate::cancel::requested() {
+        Err(RolloutError::Cancelled)
+    } else if finite {
         Ok(())
     } else {
         Err(RolloutError::NonFinite)
@@ -287,6 +292,9 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
     out.resize(n, 0.0);
     let s = Streamer::new(env, policy, horizon, key, ScoreAction::Raw)?;
     let body = |c: usize, chunk: &mut [f64]| {
+        if crate::cancel::requested() {
+            return;
+        }
         let mut scratch = s.scratch();
         s.returns((c * CHUNK) as u64, chunk, &mut scratch);
     };
@@ -296,6 +304,9 @@ pub fn rollout_returns_into<E: Environment + ?Sized>(
         out.par_chunks_mut(CHUNK)
             .enumerate()
             .for_each(|(c, chunk)| body(c, chunk));
+    }
+    if crate::cancel::requested() {
+        return Err(RolloutError::Cancelled);
     }
     if out.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -518,6 +529,10 @@ where
     F: Fn(usize, &mut [f64], &mut [f64], &mut [f64], &mut [usize]) -> bool + Sync,
 {
     let (h, dv, dw) = (batch.horizon, batch.dim_v, batch.dim_w);
+    // A cancelled chunk is skipped (its rows are discarded with the batch).
+    let body = |c: usize, rw: &mut [f64], sv: &mut [f64], sw: &mut [f64], lens: &mut [usize]| {
+        crate::cancel::requested() || body(c, rw, sv, sw, lens)
+    };
     let b = batch;
     if b.n <= CHUNK {
         return body(

@@ -113,7 +113,8 @@ fn interval(ms: &[Moments]) -> Result<Interval> {
 /// Streams `spec.n` trajectories and returns the estimates with their intervals.
 ///
 /// # Errors
-/// [`Error::Invalid`] for an unknown preset, `n < 2`, `H = 0`, `σ` negative or not finite, or
+/// [`Error::Invalid`] for an unknown preset, `n < 2`, `H = 0` or above
+/// [`crate::spec::MAX_HORIZON`], `σ` negative or not finite, or
 /// `v` of the wrong length; [`Error::Failed`] if the rollouts diverge.
 ///
 /// # Examples
@@ -137,6 +138,7 @@ pub fn estimate(spec: &EstimateSpec) -> Result<EstimateReport> {
     if spec.horizon == 0 {
         return Err(Error::invalid("--horizon must be at least 1"));
     }
+    crate::spec::check_horizon(spec.horizon)?;
     if !(spec.sigma.is_finite() && spec.sigma >= 0.0) {
         return Err(Error::invalid(format!(
             "sigma must be finite and >= 0, got {}",

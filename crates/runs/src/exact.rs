@@ -82,6 +82,10 @@ fn check(spec: &ExactSpec) -> Result<(LqgModel, Exploration, Horizon)> {
         (Some(Horizon::Infinite), true) => {
             return Err(Error::invalid("the clipped model needs a finite --horizon"));
         }
+        (Some(Horizon::Finite(h)), _) => {
+            crate::spec::check_horizon(h)?;
+            Horizon::Finite(h)
+        }
         (Some(h), _) => h,
         (None, true) => Horizon::Finite(DEFAULT_CLIPPED_HORIZON),
         (None, false) => Horizon::Infinite,
@@ -94,7 +98,8 @@ fn check(spec: &ExactSpec) -> Result<(LqgModel, Exploration, Horizon)> {
 ///
 /// # Errors
 /// [`Error::Invalid`] for an unknown preset, v not finite, σ or η negative or not finite, a
-/// zero horizon, or an infinite horizon on the clipped model; [`Error::Failed`] when the
+/// zero horizon, a finite one above [`crate::spec::MAX_HORIZON`] (both oracles cost time
+/// linear in H), or an infinite horizon on the clipped model; [`Error::Failed`] when the
 /// oracle does not converge or overflows.
 ///
 /// ```

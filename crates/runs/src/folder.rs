@@ -423,14 +423,47 @@ pub(crate) fn io_fail(what: &str, path: &Path, e: std::io::Error) -> Error {
     Error::failed(format!("cannot {what} {}: {e}", path.display()))
 }
 
-/// Checks that `dir` is absent or empty; with `force`, removes the run files a previous run
-/// left there (and only those).
+/// Checks, without creating anything, that the absent folder `dir` can be created: its
+/// nearest existing ancestor is a folder in which a file can be written (probed with a
+/// temporary file that is removed at once).
+fn check_creatable(dir: &Path) -> Result<()> {
+    let mut ancestor = dir.parent();
+    while let Some(a) = ancestor {
+        let a = if a.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            a
+        };
+        if a.exists() {
+            if !a.is_dir() {
+                return Err(Error::invalid(format!(
+                    "cannot create {}: {} is not a folder",
+                    dir.display(),
+                    a.display()
+                )));
+            }
+            return tempfile::tempfile_in(a).map(drop).map_err(|e| {
+                Error::invalid(format!(
+                    "cannot create {}: {} is not writable ({e})",
+                    dir.display(),
+                    a.display()
+                ))
+            });
+        }
+        ancestor = a.parent();
+    }
+    Ok(())
+}
+
+/// Checks that `dir` is absent and can be created, or is an empty folder; with `force`,
+/// removes the run files a previous run left there (and only those).
 ///
 /// # Errors
-/// [`Error::Invalid`] for a non-empty folder without `force`, or a path that is not a folder.
+/// [`Error::Invalid`] for a non-empty folder without `force`, a path that is not a folder, or
+/// one that cannot be created or written (under a file, in a read-only folder).
 pub fn check_out_dir(dir: &Path, force: bool, files: &[&str]) -> Result<()> {
     if !dir.exists() {
-        return Ok(());
+        return check_creatable(dir);
     }
     if !dir.is_dir() {
         return Err(Error::invalid(format!(
@@ -446,6 +479,12 @@ pub fn check_out_dir(dir: &Path, force: bool, files: &[&str]) -> Result<()> {
             dir.display()
         )));
     }
+    tempfile::tempfile_in(dir).map(drop).map_err(|e| {
+        Error::invalid(format!(
+            "output folder {} is not writable ({e})",
+            dir.display()
+        ))
+    })?;
     for f in files {
         let p = dir.join(f);
         if p.is_dir() {

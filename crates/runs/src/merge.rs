@@ -1,12 +1,14 @@
 //! Merging: combines the shard folders of one sweep into a single sweep folder, after
 //! checking that they are shards of the same sweep, that together they cover every shard,
-//! and that every run in them is complete.
+//! and that every run in them is complete with a log `sepg audit` would read
+//! ([`crate::logcheck::validate_log`]).
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::folder::{check_out_dir, is_complete, to_json_line, write_atomic};
+use crate::logcheck::validate_log;
 use crate::sweep::{SWEEP_FILE, Shard, SweepFile};
 
 fn copy_dir(from: &Path, to: &Path) -> Result<()> {
@@ -29,7 +31,8 @@ fn copy_dir(from: &Path, to: &Path) -> Result<()> {
 /// Checks the shards and returns the merged `sweep.json`.
 ///
 /// # Errors
-/// [`Error::Invalid`] when the folders are not complete shards of one sweep covering every shard.
+/// [`Error::Invalid`] when the folders are not complete shards of one sweep covering every
+/// shard, or a run's log is not valid (naming the log file and its first bad line).
 pub fn check_shards(shards: &[(PathBuf, SweepFile)]) -> Result<SweepFile> {
     let Some((first_dir, first)) = shards.first() else {
         return Err(Error::invalid("no shard folder given"));
@@ -67,6 +70,9 @@ pub fn check_shards(shards: &[(PathBuf, SweepFile)]) -> Result<SweepFile> {
                 r.dir,
                 dir.display()
             )));
+        }
+        for r in f.shard_runs() {
+            validate_log(&dir.join(&r.dir))?.require_complete()?;
         }
     }
     let missing: Vec<String> = (0..count)

@@ -15,7 +15,10 @@
 //! produces the same rows, bit for bit, as an uninterrupted one.
 //!
 //! A run stops early, after checkpointing, when its stop flag is raised (the command line
-//! raises it on Ctrl-C); it reports its progress to an [`Observer`].
+//! raises it on Ctrl-C): after the current iteration, or inside it when the process-wide
+//! cancellation request of `sepg_mdp::cancel` is raised too (the iteration's rollouts or
+//! dynamic programme then fail at once, its work is discarded and the checkpoint is that of
+//! the last completed iteration). It reports its progress to an [`Observer`].
 
 use std::fs::{self, File, OpenOptions};
 use std::io::Write;
@@ -200,6 +203,13 @@ impl Writer {
     }
 }
 
+/// Whether the run was asked to stop: its stop flag, or the process-wide cancellation request
+/// of `sepg-mdp` (which makes a rollout or dynamic programme in progress fail with a
+/// `Cancelled` error, so that a long iteration stops within one chunk of its work).
+fn stopping(opts: &RunOptions<'_>) -> bool {
+    opts.stop.load(Ordering::SeqCst) || sepg_mdp::cancel::requested()
+}
+
 /// Iterates from the checkpoint `ck` to the end of the run, then finishes the folder.
 fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) -> Result<Summary> {
     let total = resolved.iterations();
@@ -208,10 +218,17 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     let mut solver = PolicySolver::new(&resolved.checked)
         .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
     let mut state = writer.ck.state.clone();
-    if state.iteration == 0 {
-        solver
-            .init(&mut state)
-            .map_err(|e| Error::failed(e.to_string()))?;
+    if state.iteration == 0
+        && let Err(e) = solver.init(&mut state)
+    {
+        if stopping(&opts) {
+            return Err(Error::Interrupted {
+                iteration: 0,
+                total,
+                dir: dir.to_path_buf(),
+            });
+        }
+        return Err(Error::failed(e.to_string()));
     }
     opts.observer.begin(state.iteration, total);
     let mut tally = writer.ck.tally.clone();
@@ -225,6 +242,14 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
                 // Keep every row computed so far: checkpoint the state the failing iteration
                 // started from, with the rows up to it.
                 writer.checkpoint(&tally, &before, opts.observer)?;
+                if stopping(&opts) {
+                    // Cancelled in the middle of the iteration: its work is discarded.
+                    return Err(Error::Interrupted {
+                        iteration: before.iteration,
+                        total,
+                        dir: dir.to_path_buf(),
+                    });
+                }
                 return Err(Error::failed(format!(
                     "{}: iteration {} failed ({e}); the {} row(s) before it are kept in {PARTIAL_LOG_FILE}",
                     dir.display(),

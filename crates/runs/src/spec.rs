@@ -19,6 +19,7 @@ use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
 use sepg_mdp::mountain_car::MountainCar;
 use sepg_mdp::oracle::ClosedFormOracle;
+use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -26,6 +27,76 @@ use crate::error::{Error, Result};
 
 /// The version of sepg recorded in every configuration.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Largest horizon H (steps per trajectory) a run, an estimate or an exact evaluation
+/// accepts: the exact dynamic programme of a clipped preset takes about 60 µs per step, so
+/// 10⁵ steps cost seconds per evaluation (docs/RELIABILITY.md, "Sizes").
+pub const MAX_HORIZON: usize = 100_000;
+
+/// Largest number of iterations of a run (docs/RELIABILITY.md, "Sizes").
+pub const MAX_ITERATIONS: u64 = 1_000_000_000;
+
+/// Largest memory, in bytes, one batch of trajectories may need (8 GiB): sizes beyond are
+/// refused before anything is allocated (docs/RELIABILITY.md, "Sizes"). The limit does not
+/// depend on the machine, so a configuration resolves the same everywhere.
+pub const MAX_BATCH_BYTES: u64 = 8 << 30;
+
+/// Bytes a batch of `n` trajectories of `horizon` steps takes, with `dim_v` mean and `dim_w`
+/// log-standard-deviation parameters: per step the discounted reward and the cumulative
+/// scores (`1 + dim_v + dim_w` numbers of 8 bytes), per trajectory its length (8 bytes);
+/// `None` when the count overflows `u64`.
+///
+/// ```
+/// // 100 trajectories of 20 steps, one parameter of each kind: 100 · (20 · 3 + 1) · 8.
+/// assert_eq!(sepg_runs::spec::batch_bytes(100, 20, 1, 1), Some(48_800));
+/// assert_eq!(sepg_runs::spec::batch_bytes(usize::MAX, 20, 1, 1), None);
+/// ```
+pub fn batch_bytes(n: usize, horizon: usize, dim_v: usize, dim_w: usize) -> Option<u64> {
+    let per_step = 1u64.checked_add(dim_v as u64)?.checked_add(dim_w as u64)?;
+    let per_trajectory = (horizon as u64).checked_mul(per_step)?.checked_add(1)?;
+    (n as u64).checked_mul(per_trajectory)?.checked_mul(8)
+}
+
+/// Checks that a batch of `n` trajectories of `horizon` steps fits [`MAX_BATCH_BYTES`]
+/// (see [`batch_bytes`]); `what` names the option for the message.
+///
+/// # Errors
+/// [`Error::Invalid`] naming the size and the limit.
+pub fn check_batch_memory(
+    what: &str,
+    n: usize,
+    horizon: usize,
+    dims: (usize, usize),
+) -> Result<()> {
+    match batch_bytes(n, horizon, dims.0, dims.1) {
+        Some(b) if b <= MAX_BATCH_BYTES => Ok(()),
+        b => Err(Error::invalid(format!(
+            "{what} N = {n} trajectories of H = {horizon} steps need {} of memory, more than \
+             the limit of {} GiB",
+            b.map_or_else(
+                || "more than 2^64 bytes".to_owned(),
+                |b| format!("{} GiB", b.div_ceil(1 << 30))
+            ),
+            MAX_BATCH_BYTES >> 30
+        ))),
+    }
+}
+
+/// Checks `1 ≤ horizon ≤` [`MAX_HORIZON`].
+///
+/// # Errors
+/// [`Error::Invalid`] naming the limit.
+pub fn check_horizon(horizon: usize) -> Result<()> {
+    if horizon == 0 {
+        return Err(Error::invalid("horizon H must be at least 1"));
+    }
+    if horizon > MAX_HORIZON {
+        return Err(Error::invalid(format!(
+            "horizon H = {horizon} is above the limit of {MAX_HORIZON} steps"
+        )));
+    }
+    Ok(())
+}
 
 /// Environment presets accepted by `--env`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -385,6 +456,10 @@ impl Values {
             Values::One(x) => Ok(vec![*x; dim]),
             Values::Many(v) if v.len() == 1 => Ok(vec![v[0]; dim]),
             Values::Many(v) if v.len() == dim => Ok(v.clone()),
+            Values::Many(v) if dim == 1 => Err(Error::invalid(format!(
+                "{what} has {} values, the environment needs 1",
+                v.len()
+            ))),
             Values::Many(v) => Err(Error::invalid(format!(
                 "{what} has {} values, the environment needs 1 or {dim}",
                 v.len()
@@ -705,6 +780,23 @@ impl RunSpec {
         let dim_v = dim_w * env.feature_dim();
         let start = self.start(env_name, dim_v, dim_w)?;
         let schedule = self.schedule(env.constants().horizon)?;
+        check_horizon(schedule.horizon)?;
+        if schedule.iterations > MAX_ITERATIONS {
+            return Err(Error::invalid(format!(
+                "iterations = {} is above the limit of {MAX_ITERATIONS}",
+                schedule.iterations
+            )));
+        }
+        check_batch_memory("batch", schedule.batch, schedule.horizon, (dim_v, dim_w))?;
+        // The reference batch keeps one return (8 bytes) per trajectory.
+        let reference = self.reference_batch.unwrap_or(0) as u64;
+        if reference.checked_mul(8).is_none_or(|b| b > MAX_BATCH_BYTES) {
+            return Err(Error::invalid(format!(
+                "reference-batch N = {reference} returns need more than the limit of {} GiB",
+                MAX_BATCH_BYTES >> 30
+            )));
+        }
+        let feature_dim = env.feature_dim();
         let config = SepgConfig {
             env,
             algorithm: method.algorithm,
@@ -727,6 +819,10 @@ impl RunSpec {
             .check()
             .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?
             .with_certified_steps(certified_steps.unwrap_or(true));
+        // The first iteration builds the policy θ⁰: refuse here what it would refuse there.
+        let first = checked.initial_state();
+        GaussianPolicy::new(first.v, first.w, feature_dim)
+            .map_err(|e| Error::invalid(format!("invalid initial policy (v0, sigma0): {e}")))?;
         let spec = RunSpec {
             name: Some(self.name.clone().unwrap_or_else(|| algo.name().to_owned())),
             env: Some(env_name),
@@ -1420,6 +1516,49 @@ impl Resolved {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn lqg1d(f: impl FnOnce(&mut RunSpec)) -> Result<Resolved> {
+        let mut spec = RunSpec {
+            env: Some(EnvName::Lqg1d),
+            iterations: Some(1),
+            ..RunSpec::default()
+        };
+        f(&mut spec);
+        spec.resolve()
+    }
+
+    #[test]
+    fn sizes_are_refused_at_resolution_exactly_above_their_limits() {
+        // lqg1d, H = 20, one parameter of each kind: (20 · 3 + 1) · 8 = 488 bytes per
+        // trajectory; 8 GiB = 8,589,934,592 bytes hold 17,602,324 of them
+        // (8,589,934,112 bytes), one more needs 8,589,934,600.
+        assert!(lqg1d(|s| s.batch = Some(17_602_324)).is_ok());
+        let e = lqg1d(|s| s.batch = Some(17_602_325)).expect_err("too large");
+        assert!(e.is_invalid_input(), "{e}");
+        let e = lqg1d(|s| s.batch = Some(usize::MAX)).expect_err("overflow");
+        assert!(e.to_string().contains("more than 2^64 bytes"), "{e}");
+        assert!(lqg1d(|s| s.horizon = Some(MAX_HORIZON)).is_ok());
+        let e = lqg1d(|s| s.horizon = Some(MAX_HORIZON + 1)).expect_err("horizon");
+        assert!(e.is_invalid_input(), "{e}");
+        let e = lqg1d(|s| s.iterations = Some(MAX_ITERATIONS + 1)).expect_err("iterations");
+        assert!(e.is_invalid_input(), "{e}");
+        // 2^30 returns of 8 bytes are exactly 8 GiB.
+        assert!(lqg1d(|s| s.reference_batch = Some(1 << 30)).is_ok());
+        assert!(lqg1d(|s| s.reference_batch = Some((1 << 30) + 1)).is_err());
+    }
+
+    #[test]
+    fn an_initial_policy_the_policy_cannot_represent_is_refused_at_resolution() {
+        // w = ln σ must satisfy |w| < 354: ln(1e153) = 352.3 passes, ln(1e154) = 354.6 not.
+        assert!(lqg1d(|s| s.sigma0 = Some(Values::One(1e153))).is_ok());
+        for sigma in [1e154, 1e300, 1e-154] {
+            let e = lqg1d(|s| s.sigma0 = Some(Values::One(sigma))).expect_err("refused");
+            assert!(
+                e.is_invalid_input() && e.to_string().contains("sigma0"),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn resolving_a_resolved_configuration_changes_nothing() {

@@ -51,7 +51,19 @@ pub enum Seeds {
     List(Vec<u64>),
 }
 
+/// Largest number of runs of one sweep (presets × variants × σ⁰ × seeds): each run is
+/// resolved and listed in `sweep.json` before any starts (docs/RELIABILITY.md, "Sizes").
+pub const MAX_RUNS: u64 = 1_000_000;
+
 impl Seeds {
+    /// Number of seeds.
+    fn count(&self) -> u64 {
+        match self {
+            Seeds::Count(n) => *n,
+            Seeds::List(v) => v.len() as u64,
+        }
+    }
+
     fn list(&self) -> Vec<u64> {
         match self {
             Seeds::Count(n) => (0..*n).collect(),
@@ -157,9 +169,23 @@ fn path_safe(name: &str) -> bool {
 /// Expands a sweep into its resolved runs and `sweep.json` contents (for shard `shard`).
 ///
 /// # Errors
-/// [`Error::Invalid`] for an empty axis, a duplicate or unsafe variant name, a variant or
-/// base that sets a sweep axis (env, seed, sigma0), or any run whose configuration is invalid.
+/// [`Error::Invalid`] for an empty axis, more than [`MAX_RUNS`] runs, a duplicate or unsafe
+/// variant name, a variant or base that sets a sweep axis (env, seed, sigma0), or any run whose
+/// configuration is invalid.
 pub fn expand(spec: &SweepSpec, shard: Shard) -> Result<(SweepFile, Vec<Resolved>)> {
+    let runs = [
+        spec.presets.len() as u64,
+        spec.variant.len() as u64,
+        spec.sigma0.len() as u64,
+    ]
+    .iter()
+    .try_fold(spec.seeds.count(), |a, &b| a.checked_mul(b));
+    if runs.is_none_or(|r| r > MAX_RUNS) {
+        return Err(Error::invalid(format!(
+            "the sweep has {} runs, more than the limit of {MAX_RUNS}",
+            runs.map_or_else(|| "more than 2^64".to_owned(), |r| r.to_string())
+        )));
+    }
     let seeds = spec.seeds.list();
     if spec.presets.is_empty()
         || seeds.is_empty()
@@ -255,7 +281,7 @@ fn resolve_run(
     };
     base.overlay(variant).overlay(&axes).resolve().map_err(|e| {
         Error::invalid(format!(
-            "variant {name} on {} with sigma0 {sigma0}: {e}",
+            "variant {name} on {} with sigma0 {sigma0:?}: {e}",
             preset.name()
         ))
     })

@@ -591,6 +591,7 @@ pub(crate) fn check_sampled(
         return Err(ConfigError::TooFewTrajectories {
             n: n_trajectories,
             blocks,
+            per_block: min,
         });
     }
     Ok(())

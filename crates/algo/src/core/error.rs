@@ -12,14 +12,21 @@ pub enum ConfigError {
         /// The rejected value.
         nu: f64,
     },
-    /// `N` trajectories cannot be split among the blocks that run (each needs at least 2,
-    /// so that sample variances and confidence widths exist).
-    #[error("N = {n} trajectories cannot give {blocks} block(s) at least 2 trajectories each")]
+    /// `N` trajectories cannot be split among the blocks that run: each needs at least
+    /// `per_block` (2, so that sample variances and confidence widths exist; 4 for a block
+    /// of SEPG, whose ∇_w L is cross-fitted on two halves), so N ≥ `blocks · per_block`.
+    #[error(
+        "N = {n} trajectories cannot give {blocks} block(s) at least {per_block} trajectories each \
+         (this algorithm needs N >= {})",
+        blocks * per_block
+    )]
     TooFewTrajectories {
         /// Trajectories per iteration requested.
         n: usize,
         /// Blocks that run in one iteration.
         blocks: usize,
+        /// Trajectories each block needs at least.
+        per_block: usize,
     },
     /// An initial standard deviation σ⁰ is not a finite positive number.
     #[error("initial standard deviation sigma0[{index}] = {value} is not finite and positive")]

@@ -40,7 +40,11 @@ fn too_few_trajectories_for_the_blocks_is_rejected() {
     };
     assert_eq!(
         cfg.check().unwrap_err(),
-        ConfigError::TooFewTrajectories { n: 11, blocks: 3 }
+        ConfigError::TooFewTrajectories {
+            n: 11,
+            blocks: 3,
+            per_block: 4
+        }
     );
     assert!(
         SepgConfig {

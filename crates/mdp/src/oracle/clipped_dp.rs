@@ -849,6 +849,9 @@ impl ClippedDpOracle {
         };
         let mut frontier = vec![(self.s_lo, 1.0), (self.s_hi, 1.0)];
         for _ in 0..horizon {
+            if crate::cancel::requested() {
+                break;
+            }
             let mut next = Vec::new();
             for &(k, weight) in &frontier {
                 for ab in [self.a_lo, self.a_hi] {
@@ -912,6 +915,9 @@ impl ClippedDpOracle {
                     mut scale,
                 } = zones[z];
                 for _ in 1..horizon {
+                    if crate::cancel::requested() {
+                        break;
+                    }
                     centre /= lam;
                     scale = scale.hypot(spread) / lam.abs();
                     if scale >= coarse {
@@ -1200,6 +1206,9 @@ impl ClippedDpOracle {
         let g = self.gamma;
         let (mut val, mut dv) = (vec![0.0; n], vec![0.0; n]);
         for _ in 0..horizon {
+            if crate::cancel::requested() {
+                break;
+            }
             let (mut w, mut wd, mut wv) = (
                 vec![0.0; wgrid.nodes.len()],
                 vec![0.0; wgrid.nodes.len()],
@@ -1265,6 +1274,9 @@ impl ClippedDpOracle {
             vec![self.a_lo / v, self.a_hi / v]
         };
         for _ in 0..horizon {
+            if crate::cancel::requested() {
+                break;
+            }
             let mut next = Vec::with_capacity(pieces.len());
             for pc in &pieces {
                 for (l0, l1) in split(pc.lo, pc.hi, pc.alpha.x, pc.beta.x, &action_kinks) {
@@ -1365,6 +1377,9 @@ impl Recursion<'_> {
         };
         let (g, sigma) = (self.gamma, self.sigma);
         for _ in 0..self.horizon {
+            if crate::cancel::requested() {
+                break;
+            }
             if let Some(nop) = self.noise {
                 for (out, x) in smooth.iter_mut().zip(&cur) {
                     if !x.is_empty() {
@@ -1589,10 +1604,15 @@ impl ExactOracle for ClippedDpOracle {
                 ));
             }
         };
-        match params.sigma.first() {
+        let eval = match params.sigma.first() {
             Some(&sigma) => self.eval_stochastic(v[0], sigma, h, needs),
             None if self.noise > 0.0 => self.eval_deterministic_noisy(v[0], h),
             None => self.eval_deterministic_exact(v[0], h),
+        };
+        // The recursions stop early when cancelled; what they return then is discarded.
+        if crate::cancel::requested() {
+            return Err(OracleError::Cancelled);
         }
+        eval
     }
 }

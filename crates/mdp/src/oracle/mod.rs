@@ -143,6 +143,9 @@ impl ExactEval {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum OracleError {
+    /// The computation was cancelled ([`crate::cancel::request`]) before it completed.
+    #[error("cancelled")]
+    Cancelled,
     /// The model failed its own validation.
     #[error("invalid model: {0}")]
     Model(#[from] crate::lqg_model::ModelError),
