@@ -287,6 +287,27 @@ fn an_initial_policy_the_first_iteration_would_refuse_is_refused_up_front() {
 }
 
 #[test]
+fn an_initial_mean_the_environment_or_oracle_cannot_take_is_refused_without_a_folder() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    // Mountain Car: a mean of 1e300 makes the score (a − μ)/σ² · φ overflow at the first step;
+    // the clipped DP would need more elements than it allows for |v| = 1e300 on lqg1d.
+    let cases: [&[&str]; 2] = [
+        &["--env", "mountain-car", "--v0", "1e300,0,0"],
+        &["--env", "lqg1d", "--gradients", "exact", "--v0", "1e300"],
+    ];
+    for (i, case) in cases.iter().enumerate() {
+        let out = tmp.path().join(format!("run{i}"));
+        let out_s = out.display().to_string();
+        let mut args = vec!["run", "--iterations", "2", "--quiet"];
+        args.extend_from_slice(case);
+        args.extend_from_slice(&["--out", &out_s]);
+        let line = assert_usage_error(&sepg(&args));
+        assert!(line.contains("initial policy"), "{line}");
+        assert!(!out.exists(), "no partial folder for {case:?}");
+    }
+}
+
+#[test]
 fn an_unwritable_out_is_bad_input() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let file = tmp.path().join("a-file");

@@ -82,6 +82,16 @@ pub struct RunOptions<'a> {
 /// [`Error::Failed`] for I/O errors or a failing iteration; [`Error::Interrupted`] when the
 /// stop flag was raised (after checkpointing).
 pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Summary> {
+    preflight(resolved).map_err(|e| {
+        if stopping(&opts) {
+            Error::failed(format!(
+                "{}: interrupted before the run started; nothing was written",
+                dir.display()
+            ))
+        } else {
+            e
+        }
+    })?;
     fs::create_dir_all(dir).map_err(|e| io_fail("create", dir, e))?;
     let header = log_header(resolved.dims.0, resolved.dims.1);
     write_atomic(&dir.join(PARTIAL_LOG_FILE), header.as_bytes())?;
@@ -208,6 +218,26 @@ impl Writer {
 /// `Cancelled` error, so that a long iteration stops within one chunk of its work).
 fn stopping(opts: &RunOptions<'_>) -> bool {
     opts.stop.load(Ordering::SeqCst) || sepg_mdp::cancel::requested()
+}
+
+/// Runs the first iteration in memory, before anything is written: a configuration whose
+/// initial policy the environment or the oracle cannot take (a mean so large that the scores
+/// overflow, a clipped DP that would need more elements than it allows, …) is bad input, refused
+/// without leaving a folder. The solver is then dropped; the run starts afresh from θ⁰, so its
+/// results are the same bit for bit. Costs one iteration.
+fn preflight(resolved: &Resolved) -> Result<()> {
+    let refuse = |e: &dyn std::fmt::Display| {
+        Error::invalid(format!("the run cannot start from its initial policy: {e}"))
+    };
+    let mut solver = PolicySolver::new(&resolved.checked)
+        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+    if resolved.iterations() == 0 {
+        return Ok(());
+    }
+    let mut state = resolved.checked.initial_state();
+    solver.init(&mut state).map_err(|e| refuse(&e))?;
+    solver.next_iter(&mut state).map_err(|e| refuse(&e))?;
+    Ok(())
 }
 
 /// Iterates from the checkpoint `ck` to the end of the run, then finishes the folder.
