@@ -81,6 +81,7 @@ use std::fs;
 use std::path::Path;
 
 use rayon::prelude::*;
+use sepg_algo::core::check::ConstantsCheck;
 use sepg_algo::core::config::{Algorithm, GradientMode, Requirement};
 use sepg_algo::core::statement::{Covers, Scope, SelfCheck, Statement, StatementKind};
 use sepg_estimators::binomial::upper_tail;
@@ -450,6 +451,8 @@ struct Progress {
     last: Params,
     /// The summary of a finished run.
     summary: Option<Summary>,
+    /// The declared constants checked against the run's data (summary or checkpoint).
+    constants_check: ConstantsCheck,
 }
 
 /// Parameters θᵗ = (vᵗ, wᵗ).
@@ -493,7 +496,12 @@ fn log_bytes(dir: &Path, total: u64, dims: (usize, usize)) -> Result<(Vec<u8>, P
             .map_err(|e| bad(dir, format!("cannot read {SUMMARY_FILE}: {e}")))?;
         let s: Summary = serde_json::from_str(&text)
             .map_err(|e| bad(dir, format!("{SUMMARY_FILE} is malformed: {e}")))?;
-        if s.iterations != total {
+        // a run stopped by a contradiction of its constants ends before its total
+        let stopped = s.status == "stopped"
+            && s.constants_check
+                .as_ref()
+                .is_some_and(ConstantsCheck::contradicted);
+        if s.iterations != total && !(stopped && s.iterations < total) {
             return Err(bad(
                 dir,
                 format!(
@@ -510,9 +518,10 @@ fn log_bytes(dir: &Path, total: u64, dims: (usize, usize)) -> Result<(Vec<u8>, P
             ));
         }
         let progress = Progress {
-            done: total,
+            done: s.iterations,
             complete: true,
             last: Params { v, w },
+            constants_check: s.constants_check.clone().unwrap_or_default(),
             summary: Some(s),
         };
         return Ok((bytes, progress));
@@ -554,6 +563,7 @@ fn log_bytes(dir: &Path, total: u64, dims: (usize, usize)) -> Result<(Vec<u8>, P
         complete: false,
         last: Params { v: s.v, w: s.w },
         summary: None,
+        constants_check: s.constants_check,
     };
     Ok((bytes, progress))
 }
@@ -1229,6 +1239,7 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
         resolved.checked.statement(),
         per_iteration,
     );
+    let statement = statement.checked_against(&progress.constants_check);
     if let Some(d) = statement.delta
         && !(d > 0.0 && d < 1.0)
     {
@@ -1288,13 +1299,20 @@ pub fn audit(dir: &Path, tolerance: f64, alpha: f64) -> Result<AuditReport> {
     }
     auditor.failures.sort_by_key(|f| f.iteration);
     let checks = judge(&plans, &auditor.tallies, statement.kind, alpha)?;
-    let (verdict, reason) = verdict(
+    let (mut verdict, mut reason) = verdict(
         &checks,
         &auditor.failures,
         &statement,
         (progress.done, progress.complete),
         exact.is_some(),
     );
+    if let Some(why) = progress.constants_check.reason() {
+        // data that refute the constants void every bound: never "holds"
+        (verdict, reason) = (
+            Verdict::NoGuarantee,
+            format!("the run states nothing about exact J: {why}"),
+        );
+    }
     let type_one = requirement.is_some_and(|r| !r.is_type_two());
     Ok(AuditReport {
         dir: dir.display().to_string(),

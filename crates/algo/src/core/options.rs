@@ -15,6 +15,7 @@
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 //! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
 //! | [`SepgOptions::constants`] | [`ConstantsFamily::Thesis`] (`sepg run`: tight) | [`ConstantsFamily::Thesis`] |
+use crate::core::check::OnContradiction;
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use serde::{Deserialize, Serialize};
 
@@ -319,6 +320,10 @@ pub struct SepgOptions {
     /// option existed, which used the thesis's.
     #[serde(default = "ConstantsFamily::legacy")]
     pub constants: ConstantsFamily,
+    /// What the run does when an observed reward or feature contradicts the declared
+    /// constants ([`crate::core::check`]): stop (the default) or continue without a guarantee.
+    #[serde(default, skip_serializing_if = "OnContradiction::is_stop")]
+    pub on_contradiction: OnContradiction,
 }
 
 impl Default for SepgOptions {
@@ -335,6 +340,7 @@ impl Default for SepgOptions {
             schedule: Schedule::Run,
             v_direction: VDirection::Greedy,
             constants: ConstantsFamily::Thesis,
+            on_contradiction: OnContradiction::Stop,
         }
     }
 }
