@@ -7,6 +7,7 @@ use std::sync::{Arc, Mutex};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
+use sepg_algo::core::check::{OnContradiction, RawSteps};
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
@@ -180,7 +181,11 @@ struct PyCollector {
 }
 
 impl PyCollector {
-    fn collect_py(&self, py: Python<'_>, r: &BatchRequest<'_>) -> PyResult<Batch> {
+    fn collect_py(
+        &self,
+        py: Python<'_>,
+        r: &BatchRequest<'_>,
+    ) -> PyResult<(Batch, Option<RawSteps>)> {
         let seeds = |stream| (0..r.n as u64).map(move |i| r.key.trajectory_seed(i, stream));
         let request = PyBatchRequest {
             iteration: r.iteration,
@@ -219,7 +224,13 @@ impl PyCollector {
         let (n, h) = (rshape[0], rshape[1]);
         let lens = lengths_of(&lengths, n)?;
         let (Some(w), true) = (r.w, r.scores) else {
-            return Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid);
+            let batch =
+                Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid)?;
+            let raw = RawSteps {
+                rewards: rw,
+                ..RawSteps::default()
+            };
+            return Ok((batch, Some(raw)));
         };
         let policy =
             GaussianPolicy::new(r.v.to_vec(), w.to_vec(), self.features).map_err(invalid)?;
@@ -245,12 +256,26 @@ impl PyCollector {
             }
         }
         let sigma: Vec<f64> = w.iter().map(|x| x.exp()).collect();
-        Batch::from_steps(h, self.gamma, &sigma, &rw, &sv, &sw, &lens).map_err(invalid)
+        let batch =
+            Batch::from_steps(h, self.gamma, &sigma, &rw, &sv, &sw, &lens).map_err(invalid)?;
+        let raw = RawSteps {
+            rewards: rw,
+            features: phi,
+            p,
+        };
+        Ok((batch, Some(raw)))
     }
 }
 
 impl BatchCollector for PyCollector {
     fn collect(&mut self, request: &BatchRequest<'_>) -> Result<Batch, RunError> {
+        self.collect_raw(request).map(|(batch, _)| batch)
+    }
+
+    fn collect_raw(
+        &mut self,
+        request: &BatchRequest<'_>,
+    ) -> Result<(Batch, Option<RawSteps>), RunError> {
         Python::attach(|py| {
             self.collect_py(py, request).map_err(|e| {
                 let message = e.to_string();
@@ -290,9 +315,12 @@ impl Trainer {
     /// `adam_beta1` (0.9), β₂ = `adam_beta2` (0.999), ε = `adam_eps` (1e-8) proposes the
     /// change, and the largest certified step along it at most 1 is taken; docs/THEOREMS.md,
     /// "A step along any direction"), which needs the tight constants and the certified
-    /// accounting.
+    /// accounting. Every reward and feature the collector returns is checked against the
+    /// declared R_max and M_φ (docs/RELIABILITY.md): `on_contradiction` = "stop" (the default)
+    /// raises at the first value beyond its bound, "continue" goes on and records the
+    /// contradiction in the state's `constants_check` (no guarantee).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = 100, seed = 0, delta = 0.2, v0 = None, sigma0 = None, initial_budget = 0.0, nu = 0.5, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = "stop"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -319,6 +347,7 @@ impl Trainer {
         adam_beta1: Option<f64>,
         adam_beta2: Option<f64>,
         adam_eps: Option<f64>,
+        on_contradiction: &str,
     ) -> PyResult<Self> {
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
         let dim_v = actions
@@ -387,6 +416,15 @@ impl Trainer {
         };
         options.v_direction =
             self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
+        options.on_contradiction = match on_contradiction {
+            "stop" => OnContradiction::Stop,
+            "continue" => OnContradiction::Continue,
+            other => {
+                return Err(invalid(format!(
+                    "on_contradiction = {other:?} must be \"stop\" or \"continue\""
+                )));
+            }
+        };
         let solver = PolicySolver::with_collector(&config, Box::new(collector))
             .and_then(|s| s.with_options(options))
             .map_err(invalid)?;

@@ -248,6 +248,11 @@ pub struct RawSteps {
     pub p: usize,
 }
 
+/// The relative slack of every comparison: a value within 8 units in the last place of its
+/// bound (relative 1.8e-15) is not counted, so that an environment whose reward or feature
+/// reaches its bound exactly, computed in another order than the bound, raises no false alarm.
+pub const SLACK: f64 = 1.0 + 8.0 * f64::EPSILON;
+
 /// The check of one run: its limits, what to do on a contradiction and the counts so far.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Checker {
@@ -308,13 +313,13 @@ impl Checker {
 
     /// Checks the rewards of a batch of the built-in rollout engine, which keeps the
     /// discounted rewards γᵗ r_t computed as `disc · r` with `disc` the running product of γ.
-    /// Rounding is monotone, so |fl(disc · r)| > fl(disc · R) implies |r| > R: no false alarm;
-    /// the reported value is fl(disc · r)/disc, within two roundings of r. Steps whose γᵗ
-    /// underflows to 0 cannot be checked and are skipped.
+    /// Rounding is monotone, so |fl(disc · r)| > fl(disc · R') implies |r| > R' (R' = R_max
+    /// times [`SLACK`]): no false alarm; the reported value is fl(disc · r)/disc, within two
+    /// roundings of r. Steps whose γᵗ underflows to 0 cannot be checked and are skipped.
     pub(crate) fn scan_batch(&mut self, batch: &Batch, at: At) -> Option<Offence> {
         let limits = self.limits?;
         let before = self.tally.first.is_some();
-        let r_max = limits.r_max;
+        let (r_max, slack) = (limits.r_max, limits.r_max * SLACK);
         for i in 0..batch.n {
             let row = batch.rewards(i);
             let mut disc = 1.0_f64;
@@ -324,7 +329,7 @@ impl Checker {
                     break;
                 }
                 self.tally.rewards_checked += 1;
-                let bound = disc * r_max;
+                let bound = disc * slack;
                 if dr.abs() > bound {
                     self.tally.count(Constant::RMax, || {
                         offence(at, Constant::RMax, dr / disc, r_max, i, t)
@@ -352,8 +357,10 @@ impl Checker {
         let before = self.tally.first.is_some();
         let (h, p) = (batch.horizon, steps.p);
         // ‖φ‖₂ is computed with p + 1 roundings: a norm exactly at M_φ may round above it by
-        // at most (p + 2)u relatively, which is not counted.
-        let slack = 1.0 + (p as f64 + 2.0) * f64::EPSILON;
+        // at most (p + 2)u relatively, which is not counted either.
+        let r_max = limits.r_max * SLACK;
+        let m_phi = limits.m_phi * SLACK;
+        let m_phi_2 = limits.m_phi * (SLACK + (p as f64 + 2.0) * f64::EPSILON);
         for (i, &len) in batch.lengths.iter().enumerate() {
             for t in 0..len.min(h) {
                 let c = i * h + t;
@@ -361,7 +368,7 @@ impl Checker {
                     break;
                 };
                 self.tally.rewards_checked += 1;
-                if r.abs() > limits.r_max {
+                if r.abs() > r_max {
                     self.tally.count(Constant::RMax, || {
                         offence(at, Constant::RMax, r, limits.r_max, i, t)
                     });
@@ -379,8 +386,8 @@ impl Checker {
                     FeatureNorm::Euclidean => phi.iter().map(|x| x * x).sum::<f64>().sqrt(),
                 };
                 let over = match limits.norm {
-                    FeatureNorm::MaxAbs => norm > limits.m_phi,
-                    FeatureNorm::Euclidean => norm > limits.m_phi * slack,
+                    FeatureNorm::MaxAbs => norm > m_phi,
+                    FeatureNorm::Euclidean => norm > m_phi_2,
                 };
                 if over {
                     self.tally.count(Constant::MPhi, || {

@@ -256,6 +256,11 @@ class GymRun:
     ``"thesis"`` (Theorems 3.14, 4.2 and 4.3). A gymnasium environment states nothing about
     the sign of its rewards, so the tight constants are two-sided (rho = 1) unless
     ``rewards="non-positive"`` says that every reward lies in [-R_max, 0] (rho = 1/2).
+    Every reward and feature vector collected is checked against R_max and M_phi
+    (docs/RELIABILITY.md): ``on_contradiction="stop"`` (the default) raises
+    :class:`sepg.RunFailedError` at the first value beyond its bound, naming the constant and
+    the value; ``"continue"`` goes on and records the contradiction (no guarantee) in
+    ``state["constants_check"]``.
     """
 
     def __init__(
@@ -278,6 +283,7 @@ class GymRun:
         show_derivation: bool = True,
         constants: str = "tight",
         rewards: Optional[str] = None,
+        on_contradiction: str = "stop",
         **options: Any,
     ) -> None:
         gymnasium = _gymnasium()
@@ -341,6 +347,7 @@ class GymRun:
             v0=None if v0 is None else np.asarray(v0, dtype=float),
             sigma0=None if sigma0 is None else np.asarray(sigma0, dtype=float),
             initial_budget=initial_budget,
+            on_contradiction=on_contradiction,
             **options,
         )
         self.records: List[Dict[str, Any]] = []
