@@ -259,6 +259,10 @@ pub(crate) struct Checker {
     limits: Option<Limits>,
     stop: bool,
     pub(crate) tally: ConstantsCheck,
+    /// γᵗ of the steps of the last batch checked (reused buffer).
+    discs: Vec<f64>,
+    /// The bound of each step's discounted reward (reused buffer).
+    bounds: Vec<f64>,
 }
 
 /// Where the data of a scan come from.
@@ -320,26 +324,45 @@ impl Checker {
         let limits = self.limits?;
         let before = self.tally.first.is_some();
         let (r_max, slack) = (limits.r_max, limits.r_max * SLACK);
+        // γᵗ as the rollout engine computes it, and the bound fl(γᵗ · R_max · SLACK) of each
+        // step; a step whose γᵗ is 0 is not checked.
+        self.discs.clear();
+        let mut disc = 1.0_f64;
+        for _ in 0..batch.horizon {
+            if disc == 0.0 {
+                break;
+            }
+            self.discs.push(disc);
+            disc *= batch.gamma;
+        }
+        self.bounds.clear();
+        self.bounds.extend(self.discs.iter().map(|d| d * slack));
+        let sign = limits.non_positive;
         for i in 0..batch.n {
             let row = batch.rewards(i);
-            let mut disc = 1.0_f64;
-            let len = batch.lengths[i].min(row.len());
-            for (t, &dr) in row[..len].iter().enumerate() {
-                if disc == 0.0 {
-                    break;
-                }
-                self.tally.rewards_checked += 1;
-                let bound = disc * slack;
-                if dr.abs() > bound {
+            let len = batch.lengths[i].min(self.bounds.len());
+            self.tally.rewards_checked += len as u64;
+            // the common case in one branch-free pass; the offending steps only when there are
+            let any = row[..len]
+                .iter()
+                .zip(&self.bounds)
+                .fold(false, |bad, (dr, b)| {
+                    bad | (dr.abs() > *b) | (sign & (*dr > 0.0))
+                });
+            if !any {
+                continue;
+            }
+            for t in 0..len {
+                let (dr, disc) = (row[t], self.discs[t]);
+                if dr.abs() > self.bounds[t] {
                     self.tally.count(Constant::RMax, || {
                         offence(at, Constant::RMax, dr / disc, r_max, i, t)
                     });
-                } else if limits.non_positive && dr > 0.0 {
+                } else if sign && dr > 0.0 {
                     self.tally.count(Constant::RewardSign, || {
                         offence(at, Constant::RewardSign, dr / disc, 0.0, i, t)
                     });
                 }
-                disc *= batch.gamma;
             }
         }
         self.new_first(before)
@@ -481,5 +504,33 @@ mod tests {
         assert_eq!((o.trajectory, o.step, o.what), (1, 2, Constant::RMax));
         assert!((o.value + 1.5).abs() <= 4.0 * f64::EPSILON * 1.5);
         assert_eq!((c.tally.r_max, c.tally.rewards_checked), (1, 6));
+    }
+
+    /// Values within [`SLACK`] of their bound are not counted, values beyond it are.
+    #[test]
+    fn values_within_eight_ulps_of_the_bound_are_not_counted() {
+        let at = At {
+            iteration: 0,
+            block: Block::V,
+        };
+        let near = 1.0 + 4.0 * f64::EPSILON;
+        let far = 1.0 + 16.0 * f64::EPSILON;
+        for (value, counted) in [(near, 0), (far, 1)] {
+            let steps = RawSteps {
+                rewards: vec![-value],
+                features: vec![value],
+                p: 1,
+            };
+            let batch = Batch::from_steps(1, 0.5, &[], &[-value], &[], &[], &[1]).expect("batch");
+            let mut c = Checker::default();
+            c.arm(limits(FeatureNorm::MaxAbs), OnContradiction::Continue);
+            c.scan_steps(&steps, &batch, at);
+            c.scan_batch(&batch, at);
+            assert_eq!(
+                (c.tally.r_max, c.tally.m_phi),
+                (2 * counted, counted),
+                "{value}"
+            );
+        }
     }
 }
