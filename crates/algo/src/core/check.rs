@@ -352,9 +352,9 @@ impl Checker {
             if !any {
                 continue;
             }
-            for t in 0..len {
-                let (dr, disc) = (row[t], self.discs[t]);
-                if dr.abs() > self.bounds[t] {
+            let steps = row[..len].iter().zip(&self.discs).zip(&self.bounds);
+            for (t, ((&dr, &disc), &bound)) in steps.enumerate() {
+                if dr.abs() > bound {
                     self.tally.count(Constant::RMax, || {
                         offence(at, Constant::RMax, dr / disc, r_max, i, t)
                     });
