@@ -447,8 +447,8 @@ pub trait BatchCollector: Send {
 
     /// The batch of `request` with the raw rewards and features it was built from, checked
     /// against the declared constants ([`crate::core::check`]). The default collects with
-    /// [`BatchCollector::collect`] and gives no raw data: only the batch's discounted rewards
-    /// are then checked.
+    /// [`BatchCollector::collect`] and gives no raw data: only the discounted rewards of the
+    /// batches with scores are then checked.
     ///
     /// # Errors
     /// As [`BatchCollector::collect`].
@@ -518,9 +518,12 @@ impl GradientSource for CollectedSource {
             iteration: q.iteration,
             block: q.block,
         };
+        // Without the raw data only a scored batch's per-step rewards are checked, as for the
+        // built-in engine: a batch that only estimates J may hold one return per trajectory.
         let offence = match &raw {
             Some(raw) => self.checker.scan_steps(raw, &batch, at),
-            None => self.checker.scan_batch(&batch, at),
+            None if scores => self.checker.scan_batch(&batch, at),
+            None => None,
         };
         self.checker.verdict(offence)?;
         self.estimator.estimate(&batch, q.need)
