@@ -174,6 +174,16 @@ fn continue_runs_on_without_a_guarantee_and_the_audit_says_so() {
         audit.contains("no-guarantee") && !audit.contains("holds"),
         "{audit}"
     );
+    // An unfinished folder (no summary yet) is judged by its checkpoint's check, not by the
+    // statement its configuration would give.
+    std::fs::remove_file(dir.join("summary.json")).expect("remove");
+    std::fs::rename(dir.join("log.csv"), dir.join("log.partial.csv")).expect("rename");
+    let audit = audit_line(&dir);
+    assert!(
+        audit
+            .contains("no-guarantee: the run states nothing about exact J: constants contradicted"),
+        "{audit}"
+    );
 }
 
 #[test]
