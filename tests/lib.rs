@@ -5,6 +5,7 @@ mod cli_audit_review;
 mod cli_bounds;
 mod cli_certified;
 mod cli_cluster;
+mod cli_constants;
 mod cli_errors;
 mod cli_exact;
 mod cli_reproduce;

@@ -85,14 +85,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         }
         if folder::is_complete(dir) {
             let s = folder::read_summary(dir)?;
-            if !args.quiet {
-                println!(
-                    "{}: already complete ({} iterations); nothing to resume",
-                    dir.display(),
-                    s.iterations
-                );
+            // a run stopped by contradicted constants: run::resume says why it cannot go on
+            if s.status != "stopped" {
+                if !args.quiet {
+                    println!(
+                        "{}: already complete ({} iterations); nothing to resume",
+                        dir.display(),
+                        s.iterations
+                    );
+                }
+                return Ok(());
             }
-            return Ok(());
         }
         (dir.clone(), run::resume(dir, opts)?)
     } else {

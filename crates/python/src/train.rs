@@ -8,6 +8,7 @@ use numpy::PyArray2;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};
+use sepg_algo::core::check::{OnContradiction, RawSteps};
 use sepg_algo::core::config::{Algorithm, Requirement};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
@@ -182,7 +183,11 @@ struct PyCollector {
 }
 
 impl PyCollector {
-    fn collect_py(&self, py: Python<'_>, r: &BatchRequest<'_>) -> PyResult<Batch> {
+    fn collect_py(
+        &self,
+        py: Python<'_>,
+        r: &BatchRequest<'_>,
+    ) -> PyResult<(Batch, Option<RawSteps>)> {
         let seeds = |stream| (0..r.n as u64).map(move |i| r.key.trajectory_seed(i, stream));
         let request = PyBatchRequest {
             iteration: r.iteration,
@@ -231,7 +236,13 @@ impl PyCollector {
         let (n, h) = (rshape[0], rshape[1]);
         let lens = lengths_of(&lengths, n)?;
         let Some((w, (phi, fshape), (a, ashape))) = scored else {
-            return Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid);
+            let batch =
+                Batch::from_steps(h, self.gamma, &[], &rw, &[], &[], &lens).map_err(invalid)?;
+            let raw = RawSteps {
+                rewards: rw,
+                ..RawSteps::default()
+            };
+            return Ok((batch, Some(raw)));
         };
         let policy =
             GaussianPolicy::new(r.v.to_vec(), w.to_vec(), self.features).map_err(invalid)?;
@@ -255,12 +266,26 @@ impl PyCollector {
             }
         }
         let sigma: Vec<f64> = w.iter().map(|x| x.exp()).collect();
-        Batch::from_steps(h, self.gamma, &sigma, &rw, &sv, &sw, &lens).map_err(invalid)
+        let batch =
+            Batch::from_steps(h, self.gamma, &sigma, &rw, &sv, &sw, &lens).map_err(invalid)?;
+        let raw = RawSteps {
+            rewards: rw,
+            features: phi,
+            p,
+        };
+        Ok((batch, Some(raw)))
     }
 }
 
 impl BatchCollector for PyCollector {
     fn collect(&mut self, request: &BatchRequest<'_>) -> Result<Batch, RunError> {
+        self.collect_raw(request).map(|(batch, _)| batch)
+    }
+
+    fn collect_raw(
+        &mut self,
+        request: &BatchRequest<'_>,
+    ) -> Result<(Batch, Option<RawSteps>), RunError> {
         Python::attach(|py| {
             self.collect_py(py, request).map_err(|e| {
                 let message = e.to_string();
@@ -274,7 +299,7 @@ impl BatchCollector for PyCollector {
 }
 
 /// The keyword arguments of [`Trainer`]'s constructor, named when an unknown one is passed.
-const TRAINER_KEYWORDS: &str = "n_trajectories, seed, delta, v0, sigma0, initial_budget, nu, requirement, alpha, beta, lr, lr_w, reference_batch, accounting, v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps";
+const TRAINER_KEYWORDS: &str = "n_trajectories, seed, delta, v0, sigma0, initial_budget, nu, requirement, alpha, beta, lr, lr_w, reference_batch, accounting, v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps, on_contradiction";
 
 /// SEPG (Algorithm 4.3, every requirement of Table 4.1) or a comparison algorithm of
 /// Chapter 5 on trajectories collected by a Python callable. `collector(request)` receives a
@@ -302,9 +327,12 @@ impl Trainer {
     /// `adam_beta1` (0.9), β₂ = `adam_beta2` (0.999), ε = `adam_eps` (1e-8) proposes the
     /// change, and the largest certified step along it at most 1 is taken; docs/THEOREMS.md,
     /// "A step along any direction"), which needs the tight constants and the certified
-    /// accounting.
+    /// accounting. Every reward and feature the collector returns is checked against the
+    /// declared R_max and M_φ (docs/RELIABILITY.md): `on_contradiction` = "stop" (the default)
+    /// raises at the first value beyond its bound, "continue" goes on and records the
+    /// contradiction in the state's `constants_check` (no guarantee).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, **unknown))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = "stop", **unknown))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -331,6 +359,7 @@ impl Trainer {
         adam_beta1: Option<f64>,
         adam_beta2: Option<f64>,
         adam_eps: Option<f64>,
+        on_contradiction: &str,
         unknown: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         if let Some(key) = unknown.and_then(|d| d.keys().iter().next()) {
@@ -412,6 +441,15 @@ impl Trainer {
         };
         options.v_direction =
             self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
+        options.on_contradiction = match on_contradiction {
+            "stop" => OnContradiction::Stop,
+            "continue" => OnContradiction::Continue,
+            other => {
+                return Err(invalid(format!(
+                    "on_contradiction = {other:?} must be \"stop\" or \"continue\""
+                )));
+            }
+        };
         let solver = PolicySolver::with_collector(&config, Box::new(collector))
             .and_then(|s| s.with_options(options))
             .map_err(invalid)?;

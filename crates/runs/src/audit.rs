@@ -918,6 +918,7 @@ pub fn audit_observed(
         resolved.checked.statement(),
         per_iteration,
     );
+    let statement = statement.checked_against(&progress.constants_check);
     if let Some(d) = statement.delta
         && !(d > 0.0 && d < 1.0)
     {
@@ -977,13 +978,20 @@ pub fn audit_observed(
     }
     auditor.failures.sort_by_key(|f| f.iteration);
     let checks = judge(&plans, &auditor.tallies, statement.kind, alpha)?;
-    let (verdict, reason) = verdict(
+    let (mut verdict, mut reason) = verdict(
         &checks,
         &auditor.failures,
         &statement,
         (progress.done, progress.complete),
         exact.is_some(),
     );
+    if let Some(why) = progress.constants_check.reason() {
+        // data that refute the constants void every bound: never "holds"
+        (verdict, reason) = (
+            Verdict::NoGuarantee,
+            format!("the run states nothing about exact J: {why}"),
+        );
+    }
     let type_one = requirement.is_some_and(|r| !r.is_type_two());
     Ok(AuditReport {
         dir: dir.display().to_string(),

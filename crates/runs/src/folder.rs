@@ -15,6 +15,7 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
+use sepg_algo::core::check::ConstantsCheck;
 use sepg_algo::core::options::SepgOptions;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
@@ -256,7 +257,8 @@ pub struct FinalParams {
 /// `summary.json`: written last, its presence marks a complete run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
-    /// Always `"complete"`.
+    /// `"complete"`, or `"stopped"` for a run stopped because its data contradicted its
+    /// declared constants (`constants_check` says where; `iterations` counts those done).
     pub status: String,
     /// Label of the run.
     pub name: String,
@@ -314,6 +316,10 @@ pub struct Summary {
     /// (absent from the summaries of older versions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub self_check: Option<SelfCheck>,
+    /// The declared constants checked against the sampled data: counts per kind and the
+    /// first offending value (absent with exact gradients and from older summaries).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constants_check: Option<ConstantsCheck>,
 }
 
 /// The task constants γ, R, M_φ, |A|, ψ a run's bounds used (after the overrides), their

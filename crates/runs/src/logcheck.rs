@@ -12,6 +12,7 @@
 //! [`LogCheck::require_valid`] and [`LogCheck::require_complete`] turn that into the one-line
 //! error the commands print.
 
+use sepg_algo::core::check::ConstantsCheck;
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -216,6 +217,8 @@ pub(crate) struct Progress {
     pub(crate) last: Params,
     /// The summary of a finished run.
     pub(crate) summary: Option<Summary>,
+    /// The declared constants checked against the run's data (summary or checkpoint).
+    pub(crate) constants_check: ConstantsCheck,
 }
 
 /// Parameters θᵗ = (vᵗ, wᵗ).
@@ -263,7 +266,12 @@ pub(crate) fn log_bytes(
             .map_err(|e| bad(dir, format!("cannot read {SUMMARY_FILE}: {e}")))?;
         let s: Summary = serde_json::from_str(&text)
             .map_err(|e| bad(dir, format!("{SUMMARY_FILE} is malformed: {e}")))?;
-        if s.iterations != total {
+        // a run stopped by a contradiction of its constants ends before its total
+        let stopped = s.status == "stopped"
+            && s.constants_check
+                .as_ref()
+                .is_some_and(ConstantsCheck::contradicted);
+        if s.iterations != total && !(stopped && s.iterations < total) {
             return Err(bad(
                 dir,
                 format!(
@@ -280,9 +288,10 @@ pub(crate) fn log_bytes(
             ));
         }
         let progress = Progress {
-            done: total,
+            done: s.iterations,
             complete: true,
             last: Params { v, w },
+            constants_check: s.constants_check.clone().unwrap_or_default(),
             summary: Some(s),
         };
         return Ok((bytes, progress));
@@ -324,6 +333,7 @@ pub(crate) fn log_bytes(
         complete: false,
         last: Params { v: s.v, w: s.w },
         summary: None,
+        constants_check: s.constants_check,
     };
     Ok((bytes, progress))
 }

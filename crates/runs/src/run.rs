@@ -26,6 +26,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+use sepg_algo::core::check::{ConstantsCheck, Offence};
+use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::Solver;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::PolicySolver;
@@ -118,7 +120,19 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
 pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
     let resolved = load_resolved(dir)?;
     if is_complete(dir) {
-        return read_summary(dir);
+        let summary = read_summary(dir)?;
+        if let Some(reason) = summary
+            .constants_check
+            .as_ref()
+            .and_then(ConstantsCheck::reason)
+            .filter(|_| summary.status == "stopped")
+        {
+            return Err(Error::failed(format!(
+                "{}: the run stopped and cannot be resumed: {reason}",
+                dir.display()
+            )));
+        }
+        return Ok(summary);
     }
     let ck_path = dir.join(CHECKPOINT_FILE);
     let text = fs::read_to_string(&ck_path)
@@ -267,6 +281,10 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
         let before = state.clone();
         let record = match solver.next_iter(&mut state) {
             Ok(r) => r,
+            Err(RunError::ConstantsContradicted(offence)) => {
+                opts.observer.end();
+                return stop_contradicted(dir, resolved, writer, &tally, before, *offence, opts);
+            }
             Err(e) => {
                 opts.observer.end();
                 // Keep every row computed so far: checkpoint the state the failing iteration
@@ -316,6 +334,36 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     finish(dir, resolved, &ck, opts.observer)
 }
 
+/// Ends a run whose iteration `before.iteration` saw `offence`, a value contradicting the
+/// declared constants (option `on-contradiction = stop`): the rows so far and the state before
+/// that iteration, with the offence counted, are checkpointed; the log is closed and
+/// `summary.json` written with status `stopped`, a statement of kind `none` and the
+/// `constants_check` block. Returns the one-line error.
+fn stop_contradicted(
+    dir: &Path,
+    resolved: &Resolved,
+    mut writer: Writer,
+    tally: &Tally,
+    mut before: State,
+    offence: Offence,
+    opts: RunOptions<'_>,
+) -> Result<Summary> {
+    let message = RunError::ConstantsContradicted(Box::new(offence.clone())).to_string();
+    before.constants_check.record(offence);
+    writer.checkpoint(tally, &before, opts.observer)?;
+    let Writer {
+        partial, log, ck, ..
+    } = writer;
+    drop(log);
+    fs::rename(&partial, dir.join(LOG_FILE)).map_err(|e| io_fail("rename", &partial, e))?;
+    opts.observer.wrote(LOG_FILE);
+    finish(dir, resolved, &ck, opts.observer)?;
+    Err(Error::failed(format!(
+        "{}: run stopped: {message}",
+        dir.display()
+    )))
+}
+
 /// Writes `summary.json` from the final checkpoint `ck`, completing the run.
 fn finish(
     dir: &Path,
@@ -332,8 +380,13 @@ fn finish(
     });
     let wall = ck.elapsed_s;
     let rate = |x: f64| if wall > 0.0 { x / wall } else { 0.0 };
+    let contradicted = s.constants_check.contradicted();
     let summary = Summary {
-        status: "complete".into(),
+        status: if contradicted && s.iteration < resolved.iterations() {
+            "stopped".into()
+        } else {
+            "complete".into()
+        },
         name: resolved.spec.name.clone().unwrap_or_default(),
         sepg_version: VERSION.into(),
         iterations: s.iteration,
@@ -359,8 +412,18 @@ fn finish(
         constants: UsedConstants::of(resolved),
         scores: resolved.spec.scores,
         certified_steps: resolved.spec.certified_steps,
-        statement: Some(resolved.checked.statement()),
+        statement: Some(
+            resolved
+                .checked
+                .statement()
+                .checked_against(&s.constants_check),
+        ),
         self_check: Some(ck.tally.self_check),
+        constants_check: matches!(
+            resolved.checked.config().gradient,
+            sepg_algo::core::config::GradientMode::Sampled { .. }
+        )
+        .then(|| s.constants_check.clone()),
     };
     write_atomic(&dir.join(SUMMARY_FILE), to_json_line(&summary)?.as_bytes())?;
     observer.wrote(SUMMARY_FILE);

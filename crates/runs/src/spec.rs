@@ -9,6 +9,7 @@ use std::path::Path;
 
 #[cfg(feature = "clap")]
 use clap::{Args, ValueEnum};
+use sepg_algo::core::check::OnContradiction;
 use sepg_algo::core::config::reward_sign;
 use sepg_algo::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
 use sepg_algo::core::options::{
@@ -400,6 +401,28 @@ impl ConstantsName {
     }
 }
 
+/// What a run does when its data contradict its declared constants, accepted by
+/// `--on-contradiction` (docs/RELIABILITY.md, "Declared constants checked against the data").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum OnContradictionName {
+    /// Stop at the first reward or feature beyond its declared bound (exit 1).
+    Stop,
+    /// Go on, marked "constants contradicted: no guarantee".
+    Continue,
+}
+
+impl OnContradictionName {
+    /// The algorithm's option for this name.
+    pub fn option(self) -> OnContradiction {
+        match self {
+            OnContradictionName::Stop => OnContradiction::Stop,
+            OnContradictionName::Continue => OnContradiction::Continue,
+        }
+    }
+}
+
 /// What is known of the sign of the rewards, accepted by `--rewards` (tight constants only).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]
@@ -721,6 +744,11 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(long, value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rewards: Option<RewardsName>,
+    /// What the run does when an observed reward or feature exceeds its declared bound
+    /// (R_max, M_φ): stop with an error, or continue without a guarantee [default: stop].
+    #[cfg_attr(feature = "clap", arg(long = "on-contradiction", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub on_contradiction: Option<OnContradictionName>,
 }
 
 macro_rules! overlay_fields {
@@ -738,7 +766,7 @@ impl RunSpec {
             estimator, baseline, baseline_fit, log_every, sepg_version, v_direction, adam_lr,
             adam_beta1, adam_beta2, adam_eps, w_step, w_direction, metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
             reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps,
-            accounting, schedule, constants, rewards)
+            accounting, schedule, constants, rewards, on_contradiction)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
@@ -1067,10 +1095,14 @@ impl RunSpec {
             },
         };
         let defaults = SepgOptions::default();
+        let on_contradiction = self
+            .on_contradiction
+            .map_or(defaults.on_contradiction, OnContradictionName::option);
         if !algo.is_sepg() {
             return Some(SepgOptions {
                 overrides,
                 constants,
+                on_contradiction,
                 ..defaults
             });
         }
@@ -1124,6 +1156,7 @@ impl RunSpec {
                 Some(ScheduleName::Run) | None => defaults.schedule,
             },
             constants,
+            on_contradiction,
         })
     }
 
@@ -1252,6 +1285,8 @@ impl RunSpec {
             psi: o.overrides.psi,
             constants: Some(constants),
             rewards,
+            on_contradiction: (o.on_contradiction == OnContradiction::Continue)
+                .then_some(OnContradictionName::Continue),
             ..RunSpec::default()
         };
         let (sepg, naive, lb1) = match method.algorithm {

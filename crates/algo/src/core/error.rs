@@ -127,4 +127,11 @@ pub enum RunError {
     /// A checkpoint does not fit the configuration it is resumed with.
     #[error("checkpoint does not match the configuration: {0}")]
     Checkpoint(String),
+    /// An observed reward or feature contradicts the declared constants and the run stops on
+    /// a contradiction (option `on-contradiction`, docs/RELIABILITY.md).
+    #[error(
+        "constants contradicted: {0}; the bounds need true constants (raise the constant, or \
+         on-contradiction = continue runs on without a guarantee)"
+    )]
+    ConstantsContradicted(Box<crate::core::check::Offence>),
 }

@@ -1,5 +1,6 @@
 //! Shared machinery of every algorithm: configuration, records, state, executor.
 pub mod adam;
+pub mod check;
 pub mod config;
 pub mod error;
 pub mod executor;

@@ -20,6 +20,8 @@
 //! in `config.toml` (`"cross-fitted"`, `{"student-t": {"factor": 2.0}}`, `"theorem-4.9"`); the
 //! PascalCase names that older summaries wrote (`"CrossFitted"`, `{"StudentT": …}`) are read
 //! as well.
+
+use crate::core::check::OnContradiction;
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use serde::{Deserialize, Serialize};
 
@@ -353,6 +355,10 @@ pub struct SepgOptions {
     /// option existed, which used the thesis's.
     #[serde(default = "ConstantsFamily::legacy")]
     pub constants: ConstantsFamily,
+    /// What the run does when an observed reward or feature contradicts the declared
+    /// constants ([`crate::core::check`]): stop (the default) or continue without a guarantee.
+    #[serde(default, skip_serializing_if = "OnContradiction::is_stop")]
+    pub on_contradiction: OnContradiction,
 }
 
 impl Default for SepgOptions {
@@ -369,6 +375,7 @@ impl Default for SepgOptions {
             schedule: Schedule::Run,
             v_direction: VDirection::Greedy,
             constants: ConstantsFamily::Thesis,
+            on_contradiction: OnContradiction::Stop,
         }
     }
 }

@@ -2,6 +2,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::core::adam::AdamMoments;
+use crate::core::check::ConstantsCheck;
 
 /// State of a run between iterations; serialised, it is the checkpoint.
 ///
@@ -39,6 +40,10 @@ pub struct State {
     /// v-update on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adam_v: Option<AdamMoments>,
+    /// The declared constants checked against the data seen so far (omitted while nothing
+    /// was checked, e.g. with exact gradients).
+    #[serde(default, skip_serializing_if = "ConstantsCheck::is_empty")]
+    pub constants_check: ConstantsCheck,
 }
 
 impl State {
@@ -66,6 +71,7 @@ impl State {
             steps: 0,
             last_alpha: None,
             adam_v: None,
+            constants_check: ConstantsCheck::default(),
         }
     }
 

@@ -8,6 +8,7 @@
 use sepg_mdp::env::Environment;
 use serde::{Deserialize, Serialize};
 
+use crate::core::check::ConstantsCheck;
 use crate::core::config::{Algorithm, CheckedConfig, GradientMode, Requirement};
 use crate::core::options::{Accounting, Confidence, Schedule};
 
@@ -66,6 +67,35 @@ pub struct Statement {
     pub requirement: String,
     /// Why the statement is not proven (empty when it is).
     pub reasons: Vec<String>,
+}
+
+impl Statement {
+    /// This statement, unless `check` saw a value that contradicts the declared constants:
+    /// then a statement of kind `none` whose reason names the first offending value (the
+    /// bounds rest on constants the data refute; docs/RELIABILITY.md).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::check::ConstantsCheck;
+    /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+    /// use sepg_algo::core::statement::StatementKind;
+    /// let cfg = SepgConfig::new(sepg_mdp::env::Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Zv));
+    /// let s = cfg.check()?.statement();
+    /// assert_eq!(s.clone().checked_against(&ConstantsCheck::default()), s);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn checked_against(self, check: &ConstantsCheck) -> Statement {
+        match check.reason() {
+            Some(reason) => Statement {
+                kind: StatementKind::None,
+                delta: None,
+                covers: Covers::None,
+                reasons: vec![reason],
+                ..self
+            },
+            None => self,
+        }
+    }
 }
 
 /// The run's own certified bookkeeping: a certified surplus or budget below zero means the

@@ -34,6 +34,7 @@ use sepg_estimators::proven::ProvenWidths;
 use sepg_mdp::env::{AnyEnv, Environment};
 use sepg_mdp::oracle::{ClippedDpOracle, ClosedFormOracle, ExactOracle, Horizon};
 
+use crate::core::check::Limits;
 use crate::core::config::{
     Algorithm, CheckedConfig, GradientMode, Requirement, check_sampled, check_v_direction,
 };
@@ -327,6 +328,24 @@ impl Solver for PolicySolver {
 
     fn next_iter(&mut self, state: &mut State) -> Result<Record, RunError> {
         self.init(state)?;
+        let limits = Limits::of(&self.constants, &self.options);
+        if let Some(c) = self.source.checker() {
+            c.arm(limits, self.options.on_contradiction);
+        }
+        let result = self.iterate(state);
+        if let Some(c) = self.source.checker() {
+            let seen = c.take();
+            if result.is_ok() {
+                state.constants_check.merge(&seen);
+            }
+        }
+        result
+    }
+}
+
+impl PolicySolver {
+    /// One iteration of the algorithm (the state is updated only when it succeeds).
+    fn iterate(&mut self, state: &mut State) -> Result<Record, RunError> {
         match self.algorithm {
             Algorithm::Sepg(req) | Algorithm::SepgNaiveW(req) => {
                 let setup = sepg::Setup {

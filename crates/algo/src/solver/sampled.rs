@@ -11,6 +11,7 @@ use sepg_mdp::policy::GaussianPolicy;
 use sepg_mdp::rng::SeedKey;
 use sepg_mdp::rollout::{ScoreAction, rollout_into_with, rollout_returns_into};
 
+use crate::core::check::{At, Checker, RawSteps};
 use crate::core::error::RunError;
 use crate::core::seed::Block;
 use crate::solver::source::{
@@ -35,6 +36,7 @@ pub(crate) struct SampledSource {
     returns: Vec<f64>,
     estimator: BlockEstimator,
     score_action: ScoreAction,
+    checker: Checker,
 }
 
 /// The estimates of one block from its batch of trajectories: Ĵ, the requested gradients
@@ -196,6 +198,7 @@ impl SampledSource {
             estimator: BlockEstimator::new(delta, spec, constants)
                 .with_confidence_factor(confidence_factor),
             score_action: ScoreAction::Raw,
+            checker: Checker::default(),
         }
     }
 
@@ -397,7 +400,17 @@ impl GradientSource for SampledSource {
         }
         let (n, h, score) = (q.n, self.horizon, self.score_action);
         rollout_into_with(&self.env, &policy, n, h, key, score, &mut self.batch).map_err(me)?;
+        let at = At {
+            iteration: q.iteration,
+            block: q.block,
+        };
+        let offence = self.checker.scan_batch(&self.batch, at);
+        self.checker.verdict(offence)?;
         self.estimator.estimate(&self.batch, q.need)
+    }
+
+    fn checker(&mut self) -> Option<&mut Checker> {
+        Some(&mut self.checker)
     }
 }
 
@@ -431,6 +444,20 @@ pub trait BatchCollector: Send {
     /// # Errors
     /// Any [`RunError`]; it ends the iteration and leaves the state unchanged.
     fn collect(&mut self, request: &BatchRequest<'_>) -> Result<Batch, RunError>;
+
+    /// The batch of `request` with the raw rewards and features it was built from, checked
+    /// against the declared constants ([`crate::core::check`]). The default collects with
+    /// [`BatchCollector::collect`] and gives no raw data: only the discounted rewards of the
+    /// batches with scores are then checked.
+    ///
+    /// # Errors
+    /// As [`BatchCollector::collect`].
+    fn collect_raw(
+        &mut self,
+        request: &BatchRequest<'_>,
+    ) -> Result<(Batch, Option<RawSteps>), RunError> {
+        Ok((self.collect(request)?, None))
+    }
 }
 
 /// A [`GradientSource`] fed by a [`BatchCollector`], estimating with [`BlockEstimator`].
@@ -439,6 +466,7 @@ pub(crate) struct CollectedSource {
     seed: u64,
     dims: (usize, usize),
     estimator: BlockEstimator,
+    checker: Checker,
 }
 
 impl CollectedSource {
@@ -453,6 +481,7 @@ impl CollectedSource {
             seed,
             dims,
             estimator,
+            checker: Checker::default(),
         }
     }
 }
@@ -460,7 +489,7 @@ impl CollectedSource {
 impl GradientSource for CollectedSource {
     fn estimate(&mut self, q: &Query<'_>) -> Result<BlockEstimate, RunError> {
         let scores = q.need.grad_v || q.need.grad_wj || q.need.grad_wl;
-        let batch = self.collector.collect(&BatchRequest {
+        let (batch, raw) = self.collector.collect_raw(&BatchRequest {
             iteration: q.iteration,
             block: q.block,
             key: q.block.key(self.seed, q.iteration),
@@ -485,7 +514,23 @@ impl GradientSource for CollectedSource {
                 ));
             }
         }
+        let at = At {
+            iteration: q.iteration,
+            block: q.block,
+        };
+        // Without the raw data only a scored batch's per-step rewards are checked, as for the
+        // built-in engine: a batch that only estimates J may hold one return per trajectory.
+        let offence = match &raw {
+            Some(raw) => self.checker.scan_steps(raw, &batch, at),
+            None if scores => self.checker.scan_batch(&batch, at),
+            None => None,
+        };
+        self.checker.verdict(offence)?;
         self.estimator.estimate(&batch, q.need)
+    }
+
+    fn checker(&mut self) -> Option<&mut Checker> {
+        Some(&mut self.checker)
     }
 }
 

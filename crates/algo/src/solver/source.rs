@@ -1,5 +1,6 @@
 //! Where J and its gradients come from: Monte Carlo estimates or exact oracles. The iteration
 //! logic is written once against the crate-internal `GradientSource` trait.
+use crate::core::check::Checker;
 use crate::core::error::RunError;
 use crate::core::seed::Block;
 
@@ -88,4 +89,10 @@ pub struct Estimate {
 pub(crate) trait GradientSource: Send {
     /// Evaluates the policy of `q`.
     fn estimate(&mut self, q: &Query<'_>) -> Result<Estimate, RunError>;
+
+    /// The check of the declared constants against the source's data (`None` for exact
+    /// sources, which see no data).
+    fn checker(&mut self) -> Option<&mut Checker> {
+        None
+    }
 }

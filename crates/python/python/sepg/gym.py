@@ -267,6 +267,12 @@ class GymRun:
     :meth:`run` runs iterations with optional callbacks (:mod:`sepg.callbacks`), a progress
     bar and a logger (:class:`sepg.logger.Logger`); ``records`` holds one dict per iteration
     with the columns of ``log.csv``.
+
+    Every reward and feature vector collected is checked against R_max and M_phi
+    (docs/RELIABILITY.md): ``on_contradiction="stop"`` (the default) raises
+    :class:`sepg.RunFailedError` at the first value beyond its bound, naming the constant and
+    the value; ``"continue"`` goes on and records the contradiction (no guarantee) in
+    ``state["constants_check"]``.
     """
 
     def __init__(
@@ -302,6 +308,7 @@ class GymRun:
         adam_beta1: Optional[float] = None,
         adam_beta2: Optional[float] = None,
         adam_eps: Optional[float] = None,
+        on_contradiction: str = "stop",
     ) -> None:
         gymnasium = _gymnasium()
         if isinstance(env, str):
@@ -379,6 +386,7 @@ class GymRun:
             adam_beta1=adam_beta1,
             adam_beta2=adam_beta2,
             adam_eps=adam_eps,
+            on_contradiction=on_contradiction,
         )
         self.records: List[Dict[str, Any]] = []
 
@@ -503,6 +511,7 @@ def train(
     adam_beta1: Optional[float] = None,
     adam_beta2: Optional[float] = None,
     adam_eps: Optional[float] = None,
+    on_contradiction: str = "stop",
     callback: CallbackArg = None,
     progress_bar: Optional[bool] = None,
     logger: Optional[Logger] = None,
@@ -542,6 +551,7 @@ def train(
         adam_beta1=adam_beta1,
         adam_beta2=adam_beta2,
         adam_eps=adam_eps,
+        on_contradiction=on_contradiction,
     )
     run.run(iterations, callback=callback, progress_bar=progress_bar, logger=logger)
     return run

@@ -70,6 +70,7 @@ class SEPG:
         adam_beta2: Optional[float] = None,
         adam_eps: Optional[float] = None,
         show_derivation: bool = True,
+        on_contradiction: str = "stop",
     ) -> None:
         if requirement not in _REQUIREMENTS:
             raise InvalidInputError(
@@ -102,6 +103,7 @@ class SEPG:
             adam_beta1=adam_beta1,
             adam_beta2=adam_beta2,
             adam_eps=adam_eps,
+            on_contradiction=on_contradiction,
         )
         k = self.run.constants
         # the resolved arguments: a saved model is rebuilt from these without deriving
@@ -129,6 +131,7 @@ class SEPG:
             adam_beta1=adam_beta1,
             adam_beta2=adam_beta2,
             adam_eps=adam_eps,
+            on_contradiction=on_contradiction,
         )
         self._custom_features = features is not None
         self._rng = np.random.default_rng(seed)
