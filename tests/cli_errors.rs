@@ -441,7 +441,7 @@ fn walk_logs(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 /// Ctrl-C in the middle of a long iteration (an exact-gradient run on the clipped `lqg1d` at
 /// the largest horizon, whose dynamic programme takes seconds per iteration) stops the run
 /// inside that iteration: it exits with one line naming `--resume` and the checkpoint of
-/// iteration 0, not after finishing the iteration; resumed, it gives the uninterrupted log.
+/// iteration 1, not after finishing the iteration; resumed, it gives the uninterrupted log.
 #[cfg(unix)]
 #[test]
 fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
@@ -459,7 +459,7 @@ fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
             "--horizon",
             "100000",
             "--iterations",
-            "1",
+            "2",
             "--quiet",
             "--out",
         ]
@@ -476,7 +476,8 @@ fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
         .spawn()
         .expect("spawn");
     // The handler is in place once the configuration is written (it is installed before the
-    // folder is created); iteration 0 then runs for seconds.
+    // folder is created, which follows iteration 0, run in memory); iteration 1 then runs for
+    // seconds.
     let start = Instant::now();
     while !dir.join("config.toml").exists() {
         assert!(
@@ -509,7 +510,7 @@ fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
     assert_eq!(status.code(), Some(1), "{err}");
     assert_eq!(err.lines().count(), 1, "{err:?}");
     assert!(
-        err.contains("interrupted after iteration 0 of 1") && err.contains("--resume"),
+        err.contains("interrupted after iteration 1 of 2") && err.contains("--resume"),
         "{err}"
     );
     assert!(!dir.join("summary.json").exists());

@@ -29,6 +29,7 @@ use std::time::Instant;
 use sepg_algo::core::check::{ConstantsCheck, Offence};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::Solver;
+use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
 use sepg_algo::solver::PolicySolver;
 
@@ -84,7 +85,7 @@ pub struct RunOptions<'a> {
 /// [`Error::Failed`] for I/O errors or a failing iteration; [`Error::Interrupted`] when the
 /// stop flag was raised (after checkpointing).
 pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Summary> {
-    preflight(resolved).map_err(|e| {
+    let first = preflight(resolved).map_err(|e| {
         if stopping(&opts) {
             Error::failed(format!(
                 "{}: interrupted before the run started; nothing was written",
@@ -95,15 +96,27 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
         }
     })?;
     fs::create_dir_all(dir).map_err(|e| io_fail("create", dir, e))?;
-    let header = log_header(resolved.dims.0, resolved.dims.1);
-    write_atomic(&dir.join(PARTIAL_LOG_FILE), header.as_bytes())?;
-    opts.observer.wrote(PARTIAL_LOG_FILE);
-    let ck = Checkpoint {
-        log_bytes: header.len() as u64,
+    let mut log = log_header(resolved.dims.0, resolved.dims.1);
+    let mut ck = Checkpoint {
+        log_bytes: 0,
         elapsed_s: 0.0,
         tally: Tally::default(),
         state: resolved.checked.initial_state(),
     };
+    if let Some(first) = first {
+        // iteration 0 ran in memory: its row and the state after it are the folder's start
+        if first.record.iteration.is_multiple_of(resolved.log_every())
+            || first.state.iteration == resolved.iterations()
+        {
+            log.push_str(&log_row(&first.record));
+        }
+        ck.tally.add(&first.record);
+        ck.elapsed_s = first.elapsed_s;
+        ck.state = first.state;
+    }
+    ck.log_bytes = log.len() as u64;
+    write_atomic(&dir.join(PARTIAL_LOG_FILE), log.as_bytes())?;
+    opts.observer.wrote(PARTIAL_LOG_FILE);
     write_atomic(&dir.join(CHECKPOINT_FILE), to_json_line(&ck)?.as_bytes())?;
     opts.observer.wrote(CHECKPOINT_FILE);
     // The configuration goes last: a folder with a config.toml always has a checkpoint.
@@ -234,24 +247,44 @@ fn stopping(opts: &RunOptions<'_>) -> bool {
     opts.stop.load(Ordering::SeqCst) || sepg_mdp::cancel::requested()
 }
 
+/// The first iteration of a run, computed before its folder exists.
+struct First {
+    record: Record,
+    state: State,
+    elapsed_s: f64,
+}
+
 /// Runs the first iteration in memory, before anything is written: a configuration whose
 /// initial policy the environment or the oracle cannot take (a mean so large that the scores
-/// overflow, a clipped DP that would need more elements than it allows, …) is bad input, refused
-/// without leaving a folder. The solver is then dropped; the run starts afresh from θ⁰, so its
-/// results are the same bit for bit. Costs one iteration.
-fn preflight(resolved: &Resolved) -> Result<()> {
+/// overflow, a clipped DP that would need more elements than it allows, …) is bad input,
+/// refused without leaving a folder. The iteration is kept: the folder starts with its row and
+/// the state after it, as a run resumed from that checkpoint would, so the results are the same
+/// bit for bit and nothing is computed twice. `None` when there is nothing to run, or when the
+/// first batch contradicts the declared constants (the run itself then records that, as it
+/// does at any iteration).
+fn preflight(resolved: &Resolved) -> Result<Option<First>> {
     let refuse = |e: &dyn std::fmt::Display| {
         Error::invalid(format!("the run cannot start from its initial policy: {e}"))
     };
     let mut solver = PolicySolver::new(&resolved.checked)
         .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
     if resolved.iterations() == 0 {
-        return Ok(());
+        return Ok(None);
     }
+    let clock = Instant::now();
     let mut state = resolved.checked.initial_state();
-    solver.init(&mut state).map_err(|e| refuse(&e))?;
-    solver.next_iter(&mut state).map_err(|e| refuse(&e))?;
-    Ok(())
+    let record = solver
+        .init(&mut state)
+        .and_then(|()| solver.next_iter(&mut state));
+    match record {
+        Ok(record) => Ok(Some(First {
+            record,
+            state,
+            elapsed_s: clock.elapsed().as_secs_f64(),
+        })),
+        Err(RunError::ConstantsContradicted(_)) => Ok(None),
+        Err(e) => Err(refuse(&e)),
+    }
 }
 
 /// Iterates from the checkpoint `ck` to the end of the run, then finishes the folder.
