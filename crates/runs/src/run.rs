@@ -103,6 +103,7 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
         tally: Tally::default(),
         state: resolved.checked.initial_state(),
     };
+    let mut done = 0;
     if let Some(first) = first {
         // iteration 0 ran in memory: its row and the state after it are the folder's start
         if first.record.iteration.is_multiple_of(resolved.log_every())
@@ -112,6 +113,7 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
         }
         ck.tally.add(&first.record);
         ck.elapsed_s = first.elapsed_s;
+        done = first.state.iteration;
         ck.state = first.state;
     }
     ck.log_bytes = log.len() as u64;
@@ -122,6 +124,21 @@ pub fn start(dir: &Path, resolved: &Resolved, opts: RunOptions<'_>) -> Result<Su
     // The configuration goes last: a folder with a config.toml always has a checkpoint.
     write_atomic(&dir.join(CONFIG_FILE), resolved.toml()?.as_bytes())?;
     opts.observer.wrote(CONFIG_FILE);
+    let total = resolved.iterations();
+    if done > 0 {
+        // the iteration done in memory counts as any other: reported, and a stop raised
+        // meanwhile ends the run after it
+        opts.observer.begin(0, total);
+        opts.observer.advance(done);
+        if opts.stop.load(Ordering::SeqCst) && done < total {
+            opts.observer.end();
+            return Err(Error::Interrupted {
+                iteration: done,
+                total,
+                dir: dir.to_path_buf(),
+            });
+        }
+    }
     drive(dir, resolved, ck, opts)
 }
 
