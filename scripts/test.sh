@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The test command of the README: the Rust test suite and the Python test suite (pytest).
 # On first use it creates the virtual environment .venv (or $SEPG_VENV) and installs maturin,
-# numpy, gymnasium, pytest, dask, tqdm and tensorboardX into it by package name (and ray with SEPG_TEST_RAY=1, see
-# docs/PYTHON.md); then it builds the Python package with maturin and runs both suites. Fails
+# numpy, gymnasium, pytest, dask, tqdm, tensorboardX and pandas into it by package name (and
+# ray with SEPG_TEST_RAY=1, see docs/PYTHON.md); then it builds the Python package with maturin and runs both suites. Fails
 # if either suite fails or pytest collects no test (pytest's exit status 5).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +14,7 @@ if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
-    maturin numpy gymnasium pytest dask tqdm tensorboardX
+    maturin numpy gymnasium pytest dask tqdm tensorboardX pandas
 if [ "${SEPG_TEST_RAY:-0}" = 1 ]; then
     "$venv/bin/python" -m pip install --quiet --disable-pip-version-check ray
 fi
