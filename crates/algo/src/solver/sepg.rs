@@ -13,7 +13,7 @@ use sepg_bounds::outcome::StepOutcome;
 use sepg_certified::Certified;
 
 use crate::solver::realise::{CoordinateBound, DirectionalBound, realise, realise_along};
-use crate::solver::source::{Estimate, Grad, GradientSource, Need, Query};
+use crate::solver::source::{BlockEstimate, Grad, GradientSource, Need, Query};
 use crate::solver::steps::{self, Plan};
 
 /// Trajectories of each block: `n` split evenly, the remainder going to the first blocks.
@@ -90,7 +90,7 @@ fn v_update(
     setup: &Setup,
     v: &[f64],
     w: &[f64],
-    e: &Estimate,
+    e: &BlockEstimate,
     required: f64,
 ) -> Result<(Plan, Vec<f64>, f64), RunError> {
     let grad_v = e.grad_v.as_ref().ok_or(RunError::Estimator(
@@ -215,7 +215,7 @@ fn counted(
     source: &mut dyn GradientSource,
     q: &Query<'_>,
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let e = source.estimate(q)?;
     *counts.0 += e.trajectories;
     *counts.1 += e.steps;
@@ -229,7 +229,7 @@ fn v_block(
     setup: &Setup,
     (iteration, v, w, n): (u64, &[f64], &[f64], usize),
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let sim = matches!(setup.req, Requirement::Sim { .. });
     let need = Need {
         grad_v: true,
@@ -254,7 +254,7 @@ fn w_block(
     naive_w: bool,
     (iteration, v, w, n): (u64, &[f64], &[f64], usize),
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let need = Need {
         grad_v: false,
         grad_wj: true,
@@ -446,7 +446,7 @@ pub(crate) fn iterate(
 fn estimated_target(
     source: &mut dyn GradientSource,
     setup: &Setup,
-    (state, sigmas, ev): (&State, &[f64], &Estimate),
+    (state, sigmas, ev): (&State, &[f64], &BlockEstimate),
     budget: &mut Budget,
     sizes: &[usize],
     counts: (&mut u64, &mut u64),
@@ -582,7 +582,7 @@ fn iterate_alternating(
 fn w_plan(
     setup: &Setup,
     sigmas: &[f64],
-    e: &Estimate,
+    e: &BlockEstimate,
     required: f64,
     alpha: f64,
 ) -> Result<Plan, RunError> {
@@ -917,7 +917,7 @@ fn iterate_certified(
 fn certified_target(
     source: &mut dyn GradientSource,
     setup: &Setup,
-    (state, sigmas, ev, allowance): (&State, &[f64], &Estimate, f64),
+    (state, sigmas, ev, allowance): (&State, &[f64], &BlockEstimate, f64),
     sizes: &[usize],
     counts: (&mut u64, &mut u64),
 ) -> Result<(Option<Vec<f64>>, f64), RunError> {
