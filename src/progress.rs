@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sepg_runs::run::Observer;
+use sepg_runs::run::RunObserver;
 
 /// Raised by SIGINT or SIGTERM (what cluster schedulers send before killing a job): every
 /// running loop stops, within its current chunk of trajectories or step of a dynamic
@@ -62,7 +62,7 @@ impl Bar {
     }
 }
 
-impl Observer for Bar {
+impl RunObserver for Bar {
     fn begin(&self, done: u64, total: u64) {
         self.0.set_length(total);
         self.0.set_position(done);

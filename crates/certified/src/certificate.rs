@@ -199,7 +199,7 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
         .map(|slope| (required - first.lo()) / (slope.abs() * (at(1) - from).abs()))
         .filter(|g| g.is_finite() && *g >= 1.0)
         .map_or(1, |g| (g.ceil() as u64).min(total));
-    let (mut failed, mut good, mut good_enclosure) = match passes(guess) {
+    let (failed, good, good_enclosure) = match passes(guess) {
         (true, e) => {
             let (mut good, mut good_enclosure) = (guess, e);
             for _ in 0..LOCAL_STEPS {
@@ -235,6 +235,19 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
             }
         }
     };
+    let (good, good_enclosure) = bisect(passes, failed, (good, good_enclosure));
+    Ok((at(good), good_enclosure, good))
+}
+
+/// The first passing offset between `failed` (which fails) and `good` (which passes, with its
+/// enclosure), by bisection: `passes(offset)` says whether the bound at `offset` meets the
+/// requirement and gives its enclosure. Like the bracketing of [`certify_toward`] that
+/// precedes it, it takes passing to be monotone in the offset.
+fn bisect(
+    passes: impl Fn(u64) -> (bool, Interval),
+    mut failed: u64,
+    (mut good, mut good_enclosure): (u64, Interval),
+) -> (u64, Interval) {
     while good - failed > 1 {
         let mid = failed + (good - failed) / 2;
         match passes(mid) {
@@ -242,7 +255,7 @@ pub fn certify_toward<B: EnclosedBound + ?Sized>(
             (false, _) => failed = mid,
         }
     }
-    Ok((at(good), good_enclosure, good))
+    (good, good_enclosure)
 }
 
 /// Certifies `outcome` with the fast a-priori enclosure `fast` (module `rounding`) when it

@@ -76,22 +76,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
             // Trajectories needed for the proven widths to fall to |∇J|.
             let (gv, gw) = (means[0], means[2]);
-            let needed = |w: &dyn Fn(usize) -> Result<f64, EstimatorError>, g: f64| {
-                let mut n = 1usize;
-                while w(n)? > g.abs() {
-                    n *= 2;
-                }
-                let (mut lo, mut hi) = (n / 2, n);
-                while hi - lo > 1 {
-                    let mid = (lo + hi) / 2;
-                    if w(mid)? > g.abs() {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                Ok::<usize, EstimatorError>(hi)
-            };
             let nv = needed(&|n| proven.v_width(sigma, n, delta), gv)?;
             let nw = needed(&|n| proven.w_width(n, delta), gw)?;
             scale.push((preset.name(), sigma, gv, gw, nv, nw));
@@ -106,4 +90,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("| {name} | {sigma} | {gv:.4} | {gw:.4} | {nv} | {nw} |");
     }
     Ok(())
+}
+
+/// The least N at which the width `w(N)` falls to |g| (doubling, then bisection; the widths
+/// decrease in N).
+fn needed(
+    w: &dyn Fn(usize) -> Result<f64, EstimatorError>,
+    g: f64,
+) -> Result<usize, EstimatorError> {
+    let mut n = 1usize;
+    while w(n)? > g.abs() {
+        n *= 2;
+    }
+    let (mut lo, mut hi) = (n / 2, n);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if w(mid)? > g.abs() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(hi)
 }

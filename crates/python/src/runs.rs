@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};
 use sepg_runs::Error;
 use sepg_runs::folder::{self, Log, RUN_FILES};
-use sepg_runs::run::{self, Observer, RunOptions};
+use sepg_runs::run::{self, RunObserver, RunOptions};
 use sepg_runs::spec::RunSpec;
 use sepg_runs::sweep::{self, Shard, SweepOptions, SweepSpec};
 
@@ -60,7 +60,7 @@ fn run_error(e: Error) -> PyErr {
     }
 }
 
-impl Observer for SignalWatch {
+impl RunObserver for SignalWatch {
     fn advance(&self, _done: u64) {
         match self.last.lock() {
             Ok(mut last) if last.elapsed() >= SIGNAL_PERIOD => *last = Instant::now(),

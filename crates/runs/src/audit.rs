@@ -93,7 +93,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::folder::{SUMMARY_FILE, Summary, load_resolved};
 use crate::logcheck::{Row, bad, log_bytes, parse_log};
-use crate::run::{Observer, Silent};
+use crate::run::{RunObserver, Silent};
 use crate::spec::{AlgoName, RunSpec};
 
 /// Family-wise significance level of the tests of a run (and of the groups of a sweep),
@@ -429,7 +429,7 @@ fn evaluate_all(
     exact: &ExactJ,
     points: Vec<Vec<u64>>,
     iterations: u64,
-    observer: &dyn Observer,
+    observer: &dyn RunObserver,
 ) -> Result<HashMap<Vec<u64>, f64>> {
     let mut points = points;
     points.sort_unstable();
@@ -876,7 +876,7 @@ pub fn audit_observed(
     dir: &Path,
     tolerance: f64,
     alpha: f64,
-    observer: &dyn Observer,
+    observer: &dyn RunObserver,
 ) -> Result<AuditReport> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(Error::invalid(format!(

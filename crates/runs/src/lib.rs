@@ -38,6 +38,6 @@ pub mod spec;
 pub mod sweep;
 
 pub use error::{Error, Result};
-pub use run::{RunOptions, Silent, resume, start};
+pub use run::{RunObserver, RunOptions, Silent, resume, start};
 pub use spec::{Resolved, RunSpec};
 pub use sweep::{SweepOptions, SweepSpec};

@@ -18,7 +18,7 @@
 //! raises it on Ctrl-C): after the current iteration, or inside it when the process-wide
 //! cancellation request of `sepg_mdp::cancel` is raised too (the iteration's rollouts or
 //! dynamic programme then fail at once, its work is discarded and the checkpoint is that of
-//! the last completed iteration). It reports its progress to an [`Observer`].
+//! the last completed iteration). It reports its progress to a [`RunObserver`].
 
 use std::fs::{self, File, OpenOptions};
 use std::io::Write;
@@ -43,7 +43,7 @@ use crate::spec::{Resolved, VERSION};
 
 /// Receives the progress of a run (iterations) or of a sweep (runs). Every method does
 /// nothing by default; implementations must be shareable across the threads of a sweep.
-pub trait Observer: Sync {
+pub trait RunObserver: Sync {
     /// Called once before the work starts: `done` of `total` units are already done.
     fn begin(&self, _done: u64, _total: u64) {}
     /// Called after each unit of work: `done` units are done so far.
@@ -64,7 +64,7 @@ pub trait Observer: Sync {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Silent;
 
-impl Observer for Silent {}
+impl RunObserver for Silent {}
 
 /// How a run is driven: checkpoint period, stop flag and progress observer.
 #[derive(Clone, Copy)]
@@ -75,7 +75,7 @@ pub struct RunOptions<'a> {
     /// [`Error::Interrupted`].
     pub stop: &'a AtomicBool,
     /// Receives the number of iterations done.
-    pub observer: &'a dyn Observer,
+    pub observer: &'a dyn RunObserver,
 }
 
 /// Starts a new run of `resolved` in `dir` (created if needed; the caller has checked it is
@@ -234,7 +234,12 @@ impl Writer {
 
     /// Appends the buffered rows to the log, syncs it, and replaces the checkpoint by one for
     /// `tally` and `state`, telling `observer` after each of the two writes.
-    fn checkpoint(&mut self, tally: &Tally, state: &State, observer: &dyn Observer) -> Result<()> {
+    fn checkpoint(
+        &mut self,
+        tally: &Tally,
+        state: &State,
+        observer: &dyn RunObserver,
+    ) -> Result<()> {
         self.log
             .write_all(self.chunk.as_bytes())
             .and_then(|()| self.log.sync_data())
@@ -419,7 +424,7 @@ fn finish(
     dir: &Path,
     resolved: &Resolved,
     ck: &Checkpoint,
-    observer: &dyn Observer,
+    observer: &dyn RunObserver,
 ) -> Result<Summary> {
     let s = &ck.state;
     let v_star = resolved.v_star();
@@ -491,7 +496,7 @@ mod tests {
         stop: &'a AtomicBool,
     }
 
-    impl Observer for StopAt<'_> {
+    impl RunObserver for StopAt<'_> {
         fn advance(&self, done: u64) {
             if done == self.at {
                 self.stop.store(true, Ordering::SeqCst);
@@ -506,7 +511,7 @@ mod tests {
         count: std::sync::atomic::AtomicUsize,
     }
 
-    impl Observer for AbortAfter {
+    impl RunObserver for AbortAfter {
         fn wrote(&self, _file: &str) {
             if self.count.fetch_add(1, Ordering::SeqCst) + 1 == self.after {
                 std::process::abort();
@@ -518,7 +523,7 @@ mod tests {
     #[derive(Default)]
     struct Writes(std::sync::Mutex<Vec<String>>);
 
-    impl Observer for Writes {
+    impl RunObserver for Writes {
         fn wrote(&self, file: &str) {
             self.0.lock().expect("lock").push(file.to_owned());
         }

@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 use crate::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, audit, broken_runs_p_value};
 use crate::error::{Error, Result};
 use crate::folder::{CONFIG_FILE, check_out_dir, is_complete, to_json_line, write_atomic};
-use crate::run::{self, Observer, RunOptions, Silent};
+use crate::run::{self, RunObserver, RunOptions, Silent};
 use crate::spec::{EnvName, Resolved, RunSpec, Values, toml_message};
 
 /// The sweep description file.
@@ -377,7 +377,7 @@ pub struct SweepOptions<'a> {
     /// When raised, every run stops after its current iteration and checkpoints.
     pub stop: &'a AtomicBool,
     /// Receives the number of runs finished.
-    pub observer: &'a dyn Observer,
+    pub observer: &'a dyn RunObserver,
 }
 
 /// Runs every incomplete run of the shard in `dir` (which holds `file` as `sweep.json`), in

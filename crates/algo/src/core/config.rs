@@ -289,6 +289,32 @@ impl SepgConfig {
     pub fn check(mut self) -> Result<CheckedConfig, ConfigError> {
         self.algorithm.validate()?;
         self.options.validate()?;
+        self.check_options()?;
+        self = self.override_gamma()?;
+        if self.options.constants
+            == (ConstantsFamily::Tight {
+                rewards: RewardSign::NonPositive,
+            })
+            && reward_sign(&self.env) != RewardSign::NonPositive
+        {
+            return Err(ConfigError::UnsupportedOption {
+                option: "rewards",
+                reason: "the environment has positive rewards (Mountain Car's goal reward)",
+            });
+        }
+        self.check_start()?;
+        self.check_gradient_mode()?;
+        let constants = self.task_constants()?;
+        check_v_direction(&self.options, &constants)?;
+        Ok(CheckedConfig {
+            inner: self,
+            constants,
+            certified: true,
+        })
+    }
+
+    /// Options that apply only to some algorithms or environments.
+    fn check_options(&self) -> Result<(), ConfigError> {
         let requirement = match self.algorithm {
             Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => Some(r),
             _ => None,
@@ -309,6 +335,12 @@ impl SepgConfig {
                 reason: "the metagradient direction needs a scalar action",
             });
         }
+        Ok(())
+    }
+
+    /// The configuration with its environment replaced by one with the overridden discount
+    /// factor, if any.
+    fn override_gamma(mut self) -> Result<Self, ConfigError> {
         if let Some(gamma) = self.options.overrides.gamma {
             self.env = match self.env {
                 AnyEnv::Lqg(e) => {
@@ -330,17 +362,12 @@ impl SepgConfig {
                 ),
             };
         }
-        if self.options.constants
-            == (ConstantsFamily::Tight {
-                rewards: RewardSign::NonPositive,
-            })
-            && reward_sign(&self.env) != RewardSign::NonPositive
-        {
-            return Err(ConfigError::UnsupportedOption {
-                option: "rewards",
-                reason: "the environment has positive rewards (Mountain Car's goal reward)",
-            });
-        }
+        Ok(self)
+    }
+
+    /// The run's length and its start: iterations, horizon, B⁰, the dimensions and values of
+    /// v⁰ and σ⁰.
+    fn check_start(&self) -> Result<(), ConfigError> {
         if self.iterations == 0 {
             return Err(ConfigError::ZeroIterations);
         }
@@ -375,6 +402,11 @@ impl SepgConfig {
                 return Err(ConfigError::InvalidSigma { index, value });
             }
         }
+        Ok(())
+    }
+
+    /// The batch size and δ of the sampled mode, or an exact oracle for the exact mode.
+    fn check_gradient_mode(&self) -> Result<(), ConfigError> {
         match self.gradient {
             GradientMode::Sampled { delta } => {
                 check_sampled(self.algorithm, self.n_trajectories, delta)?;
@@ -392,6 +424,12 @@ impl SepgConfig {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The task constants of the bounds: the environment's, after the overrides, in the
+    /// chosen family.
+    fn task_constants(&self) -> Result<TaskConstants, ConfigError> {
         let k = self.env.constants();
         let o = self.options.overrides;
         let constants = TaskConstants::new(
@@ -406,12 +444,7 @@ impl SepgConfig {
         })
         .and_then(|c| c.with_family(self.options.constants.family(self.horizon)))
         .map_err(|e| ConfigError::Environment(e.to_string()))?;
-        check_v_direction(&self.options, &constants)?;
-        Ok(CheckedConfig {
-            inner: self,
-            constants,
-            certified: true,
-        })
+        Ok(constants)
     }
 }
 

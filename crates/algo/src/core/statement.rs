@@ -156,69 +156,27 @@ fn requirement_text(req: Requirement, b0: f64) -> String {
 pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
     let cfg = checked.config();
     let opts = &cfg.options;
-    let none = |reason: &str| Statement {
-        kind: StatementKind::None,
-        scope: Scope::Iteration,
-        delta: None,
-        covers: Covers::None,
-        requirement: "none".into(),
-        reasons: vec![reason.into()],
-    };
     let req = match cfg.algorithm {
         Algorithm::Sepg(r) | Algorithm::SepgNaiveW(r) => r,
-        _ => return none("a comparison algorithm: no safety requirement"),
+        _ => return none_statement("a comparison algorithm: no safety requirement"),
     };
     if matches!(req, Requirement::Sim { .. }) {
-        return none("SIM-ν moves v and w together from one batch: no joint bound");
+        return none_statement("SIM-ν moves v and w together from one batch: no joint bound");
     }
     if opts.accounting == Accounting::Estimated {
-        let mut s = none("requirements built on estimated J (the thesis's bookkeeping, Sec 4.4.4)");
+        let mut s = none_statement(
+            "requirements built on estimated J (the thesis's bookkeeping, Sec 4.4.4)",
+        );
         s.requirement = requirement_text(req, cfg.initial_budget);
         return s;
     }
     let mut reasons = Vec::new();
     let (delta, scope) = match cfg.gradient {
         GradientMode::Exact => (None, Scope::Run),
-        GradientMode::Sampled { delta } => {
-            match opts.confidence {
-                Confidence::None => {
-                    return none("confidence none: estimates are used as if exact");
-                }
-                Confidence::StudentT { .. } => reasons.push(
-                    "Student-t widths cover only asymptotically (docs/ERRATA.md §14)".to_string(),
-                ),
-                Confidence::SubGaussian => {
-                    if opts.w_step == crate::core::options::WStep::Theorem49
-                        && matches!(cfg.algorithm, Algorithm::Sepg(_))
-                    {
-                        reasons.push(
-                            "Theorem 4.9's step reads the Student-t width of ∇̂_w L".to_string(),
-                        );
-                    }
-                }
-            }
-            match opts.schedule {
-                Schedule::Run => (Some(delta), Scope::Run),
-                // Per-iteration widths bound MI's per-step requirement at K·δ per iteration
-                // (union over its K statements); the cumulative requirements get nothing.
-                Schedule::Iteration if req == Requirement::Mi => {
-                    let k = crate::solver::statements_per_iteration(
-                        cfg.algorithm,
-                        opts,
-                        (cfg.v0.len(), cfg.sigma0.len()),
-                    );
-                    (Some((k as f64 * delta).min(1.0)), Scope::Iteration)
-                }
-                Schedule::Iteration => {
-                    let mut s = none(
-                        "widths at level δ each (schedule iteration) do not bound a cumulative \
-                         requirement",
-                    );
-                    s.requirement = requirement_text(req, cfg.initial_budget);
-                    return s;
-                }
-            }
-        }
+        GradientMode::Sampled { delta } => match sampled_level(checked, req, delta, &mut reasons) {
+            Ok(level) => level,
+            Err(statement) => return statement,
+        },
     };
     if !checked.certified() {
         reasons.push("steps are not certified: rounding can break a bound".to_string());
@@ -238,6 +196,68 @@ pub(crate) fn classify(checked: &CheckedConfig) -> Statement {
         },
         requirement: requirement_text(req, cfg.initial_budget),
         reasons,
+    }
+}
+
+/// The statement `none`, for `reason`.
+fn none_statement(reason: &str) -> Statement {
+    Statement {
+        kind: StatementKind::None,
+        scope: Scope::Iteration,
+        delta: None,
+        covers: Covers::None,
+        requirement: "none".into(),
+        reasons: vec![reason.into()],
+    }
+}
+
+/// The level and scope of a sampled run's statement, with the reasons that make it
+/// approximate pushed to `reasons`; `Err` with the statement `none` when its widths bound
+/// nothing.
+fn sampled_level(
+    checked: &CheckedConfig,
+    req: Requirement,
+    delta: f64,
+    reasons: &mut Vec<String>,
+) -> Result<(Option<f64>, Scope), Statement> {
+    let cfg = checked.config();
+    let opts = &cfg.options;
+    match opts.confidence {
+        Confidence::None => {
+            return Err(none_statement(
+                "confidence none: estimates are used as if exact",
+            ));
+        }
+        Confidence::StudentT { .. } => reasons
+            .push("Student-t widths cover only asymptotically (docs/ERRATA.md §14)".to_string()),
+        Confidence::SubGaussian => {
+            if opts.w_step == crate::core::options::WStep::Theorem49
+                && matches!(cfg.algorithm, Algorithm::Sepg(_))
+            {
+                reasons.push("Theorem 4.9's step reads the Student-t width of ∇̂_w L".to_string());
+            }
+        }
+    }
+    match opts.schedule {
+        Schedule::Run => Ok((Some(delta), Scope::Run)),
+        // Per-iteration widths bound MI's per-step requirement at K·δ per iteration
+        // (union over its K statements); the cumulative requirements get nothing.
+        Schedule::Iteration if req == Requirement::Mi => {
+            let k = crate::solver::statements_per_iteration(
+                cfg.algorithm,
+                opts,
+                (cfg.v0.len(), cfg.sigma0.len()),
+            );
+            Ok((Some((k as f64 * delta).min(1.0)), Scope::Iteration))
+        }
+        Schedule::Iteration => {
+            let mut s = none_statement(
+                "widths at level δ each (schedule iteration) do not bound a cumulative \
+                 requirement",
+            );
+            s.requirement = requirement_text(req, cfg.initial_budget);
+            Err(s)
+        }
     }
 }
 

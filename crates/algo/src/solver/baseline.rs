@@ -10,7 +10,7 @@ use crate::core::state::State;
 use sepg_bounds::budget::Budget;
 use sepg_bounds::constants::TaskConstants;
 
-use crate::solver::source::{GradientSource, Need, Query};
+use crate::solver::source::{Grad, GradientSource, Need, Query};
 use crate::solver::steps;
 
 /// Runs iteration `state.iteration` of a comparison algorithm (`algorithm` must not be a
@@ -46,62 +46,21 @@ pub(crate) fn iterate(
     let mut v_new = state.v.clone();
     let mut w_new = state.w.clone();
     let mut adam = state.adam.clone();
-    let (alpha, beta, guaranteed_v, below_noise_v) = match algorithm {
-        Algorithm::GpomdpConst { alpha, beta } => {
-            axpy(&mut v_new, alpha, &gv.value);
-            if let Some(gw) = &e.grad_wj {
-                axpy(&mut w_new, beta, &gw.value);
-            }
-            (alpha, beta, None, false)
-        }
-        Algorithm::GpomdpAdam {
-            lr_v,
-            lr_w,
-            beta1,
-            beta2,
-            epsilon,
-        } => {
-            let (mv, mw) = adam.get_or_insert_with(|| {
-                (
-                    AdamMoments::zeros(state.v.len()),
-                    AdamMoments::zeros(state.w.len()),
-                )
-            });
-            let dv = mv.step(&gv.value, lr_v, beta1, beta2, epsilon);
-            axpy(&mut v_new, 1.0, &dv);
-            if let Some(gw) = &e.grad_wj {
-                let dw = mw.step(&gw.value, lr_w, beta1, beta2, epsilon);
-                axpy(&mut w_new, 1.0, &dw);
-            }
-            (lr_v, lr_w, None, false)
-        }
-        _ => {
-            let sigma = state.w.iter().fold(f64::INFINITY, |m, &w| m.min(w.exp()));
-            match steps::ada_step(k, sigma, gv)? {
-                Some((alpha, guaranteed)) => {
-                    axpy(&mut v_new, alpha, &gv.value);
-                    (alpha, 0.0, Some(guaranteed), false)
-                }
-                None => (0.0, 0.0, None, true),
-            }
-        }
-    };
+    let (alpha, beta, guaranteed_v, below_noise_v) = step(
+        algorithm,
+        k,
+        state,
+        (gv, e.grad_wj.as_ref()),
+        (&mut v_new, &mut w_new),
+        &mut adam,
+    )?;
     if v_new.iter().chain(w_new.iter()).any(|x| !x.is_finite()) {
         return Err(RunError::NonFinite {
             what: "policy parameters",
             iteration: t,
         });
     }
-    // The budget B (Definition 4.3) of the comparison algorithms is logged, never used.
-    let budget = match state.pending {
-        Some(p) => Budget::new(state.budget, p, None)
-            .and_then(|mut b| b.record_exploratory(e.j).map(|_| b.value()))
-            .map_err(|_| RunError::NonFinite {
-                what: "budget",
-                iteration: t,
-            })?,
-        None => state.budget,
-    };
+    let budget = logged_budget(state, e.j, t)?;
     let record = Record {
         iteration: t,
         v: state.v.clone(),
@@ -139,6 +98,72 @@ pub(crate) fn iterate(
     state.trajectories = record.trajectories;
     state.steps = record.steps;
     Ok(record)
+}
+
+/// The step of `algorithm` from the estimates `(∇̂_v J, ∇̂_w J)`, applied to `(v, w)`: returns
+/// (α, β, the guaranteed improvement of the adaptive step, whether it was below noise).
+fn step(
+    algorithm: Algorithm,
+    k: &TaskConstants,
+    state: &State,
+    (gv, gw): (&Grad, Option<&Grad>),
+    (v_new, w_new): (&mut [f64], &mut [f64]),
+    adam: &mut Option<(AdamMoments, AdamMoments)>,
+) -> Result<(f64, f64, Option<f64>, bool), RunError> {
+    Ok(match algorithm {
+        Algorithm::GpomdpConst { alpha, beta } => {
+            axpy(v_new, alpha, &gv.value);
+            if let Some(gw) = gw {
+                axpy(w_new, beta, &gw.value);
+            }
+            (alpha, beta, None, false)
+        }
+        Algorithm::GpomdpAdam {
+            lr_v,
+            lr_w,
+            beta1,
+            beta2,
+            epsilon,
+        } => {
+            let (mv, mw) = adam.get_or_insert_with(|| {
+                (
+                    AdamMoments::zeros(state.v.len()),
+                    AdamMoments::zeros(state.w.len()),
+                )
+            });
+            let dv = mv.step(&gv.value, lr_v, beta1, beta2, epsilon);
+            axpy(v_new, 1.0, &dv);
+            if let Some(gw) = gw {
+                let dw = mw.step(&gw.value, lr_w, beta1, beta2, epsilon);
+                axpy(w_new, 1.0, &dw);
+            }
+            (lr_v, lr_w, None, false)
+        }
+        _ => {
+            let sigma = state.w.iter().fold(f64::INFINITY, |m, &w| m.min(w.exp()));
+            match steps::ada_step(k, sigma, gv)? {
+                Some((alpha, guaranteed)) => {
+                    axpy(v_new, alpha, &gv.value);
+                    (alpha, 0.0, Some(guaranteed), false)
+                }
+                None => (0.0, 0.0, None, true),
+            }
+        }
+    })
+}
+
+/// The budget B (Definition 4.3) of the comparison algorithms, logged and never used: B plus
+/// the change of the estimated J since the last iteration.
+fn logged_budget(state: &State, j: f64, t: u64) -> Result<f64, RunError> {
+    Ok(match state.pending {
+        Some(p) => Budget::new(state.budget, p, None)
+            .and_then(|mut b| b.record_exploratory(j).map(|_| b.value()))
+            .map_err(|_| RunError::NonFinite {
+                what: "budget",
+                iteration: t,
+            })?,
+        None => state.budget,
+    })
 }
 
 fn axpy(x: &mut [f64], a: f64, y: &[f64]) {

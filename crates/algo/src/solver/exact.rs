@@ -3,7 +3,7 @@ use sepg_bounds::constants::TaskConstants;
 use sepg_mdp::oracle::{ExactOracle, Exploration, Horizon, Needs};
 
 use crate::core::error::RunError;
-use crate::solver::source::{Estimate, Grad, GradientSource, Query, SurrogateParts};
+use crate::solver::source::{BlockEstimate, Grad, GradientSource, Query, SurrogateParts};
 use crate::solver::steps;
 
 /// A [`GradientSource`] backed by an exact oracle: no trajectories, ε = 0.
@@ -28,7 +28,7 @@ impl ExactSource {
 }
 
 impl GradientSource for ExactSource {
-    fn estimate(&mut self, q: &Query<'_>) -> Result<Estimate, RunError> {
+    fn estimate(&mut self, q: &Query<'_>) -> Result<BlockEstimate, RunError> {
         let exploration = match q.w {
             Some(w) => Exploration::Gaussian { w: w.to_vec() },
             None => Exploration::Deterministic,
@@ -58,7 +58,7 @@ impl GradientSource for ExactSource {
             grad_v: e.grad_v.clone(),
             mixed_sigma: e.mixed_sigma_v(),
         });
-        Ok(Estimate {
+        Ok(BlockEstimate {
             j: e.j,
             grad_v: q.need.grad_v.then(|| Grad::exact(e.grad_v.clone())),
             grad_wj: q.need.grad_wj.then(|| Grad::exact(e.grad_w.clone())),

@@ -14,9 +14,7 @@ use sepg_mdp::rollout::{ScoreAction, rollout_into_with, rollout_returns_into};
 use crate::core::check::{At, Checker, RawSteps};
 use crate::core::error::RunError;
 use crate::core::seed::Block;
-use crate::solver::source::{
-    Estimate as BlockEstimate, Grad, GradientSource, Need, Query, SurrogateParts,
-};
+use crate::solver::source::{BlockEstimate, Grad, GradientSource, Need, Query, SurrogateParts};
 
 fn ee(e: sepg_estimators::EstimatorError) -> RunError {
     RunError::Estimator(e.to_string())

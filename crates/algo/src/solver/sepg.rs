@@ -13,7 +13,7 @@ use sepg_bounds::outcome::StepOutcome;
 use sepg_certified::Certified;
 
 use crate::solver::realise::{CoordinateBound, DirectionalBound, realise, realise_along};
-use crate::solver::source::{Estimate, Grad, GradientSource, Need, Query};
+use crate::solver::source::{BlockEstimate, Grad, GradientSource, Need, Query};
 use crate::solver::steps::{self, Plan};
 
 /// Trajectories of each block: `n` split evenly, the remainder going to the first blocks.
@@ -90,7 +90,7 @@ fn v_update(
     setup: &Setup,
     v: &[f64],
     w: &[f64],
-    e: &Estimate,
+    e: &BlockEstimate,
     required: f64,
 ) -> Result<(Plan, Vec<f64>, f64), RunError> {
     let grad_v = e.grad_v.as_ref().ok_or(RunError::Estimator(
@@ -215,7 +215,7 @@ fn counted(
     source: &mut dyn GradientSource,
     q: &Query<'_>,
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let e = source.estimate(q)?;
     *counts.0 += e.trajectories;
     *counts.1 += e.steps;
@@ -229,7 +229,7 @@ fn v_block(
     setup: &Setup,
     (iteration, v, w, n): (u64, &[f64], &[f64], usize),
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let sim = matches!(setup.req, Requirement::Sim { .. });
     let need = Need {
         grad_v: true,
@@ -254,7 +254,7 @@ fn w_block(
     naive_w: bool,
     (iteration, v, w, n): (u64, &[f64], &[f64], usize),
     counts: (&mut u64, &mut u64),
-) -> Result<Estimate, RunError> {
+) -> Result<BlockEstimate, RunError> {
     let need = Need {
         grad_v: false,
         grad_wj: true,
@@ -298,12 +298,10 @@ pub(crate) fn iterate(
     state: &mut State,
 ) -> Result<Record, RunError> {
     let Setup {
-        k,
         req,
         naive_w,
         n,
         opts,
-        certify,
         ..
     } = *setup;
     if opts.accounting == Accounting::Certified {
@@ -371,35 +369,14 @@ pub(crate) fn iterate(
     let v_log = BlockLog::from_plan(&v_plan);
 
     // Target block (LV, ZV, SIM-ν): evaluate θ_Tᵗ = (vᵗ, w_T) and update the budget (line 12).
-    let mut w_target = Some(state.w.clone());
-    let mut j_target = j_t;
-    if matches!(
-        req,
-        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
-    ) {
-        w_target = if req == Requirement::Lv {
-            let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
-                "the v-block returned no w-gradient".into(),
-            ))?;
-            let mut wt = state.w.clone();
-            if let Some((h, dw)) =
-                steps::lv_target(k, &sigmas, gwj, budget.required_improvement(), certify)?
-            {
-                wt[h] += dw;
-            }
-            Some(wt)
-        } else {
-            None
-        };
-        j_target = target_j(
-            source,
-            (t, &state.v, w_target.as_deref(), sizes[1]),
-            (&mut trajectories, &mut env_steps),
-        )?;
-        if state.target_prev.is_some() {
-            budget.record_target(j_target).map_err(budget_error)?;
-        }
-    }
+    let (w_target, j_target) = estimated_target(
+        source,
+        setup,
+        (state, &sigmas, &ev),
+        &mut budget,
+        &sizes,
+        (&mut trajectories, &mut env_steps),
+    )?;
 
     // w-block.
     let mut w_new = state.w.clone();
@@ -459,6 +436,58 @@ pub(crate) fn iterate(
     state.steps = env_steps;
     state.last_alpha = Some(alpha);
     Ok(record)
+}
+
+/// The target block of an iteration with the thesis's bookkeeping (LV, ZV, SIM-ν; the
+/// exploratory policy itself for the other variants; `sizes` the batch sizes of the
+/// iteration's blocks): θ_Tᵗ's log σ (LV: the step of (4.17) for the budget's requirement;
+/// ZV, SIM-ν: none, the deterministic policy) and its J, recorded in `budget` (line 12 of
+/// Algorithm 4.3).
+fn estimated_target(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    (state, sigmas, ev): (&State, &[f64], &BlockEstimate),
+    budget: &mut Budget,
+    sizes: &[usize],
+    counts: (&mut u64, &mut u64),
+) -> Result<(Option<Vec<f64>>, f64), RunError> {
+    let Setup {
+        k, req, certify, ..
+    } = *setup;
+    if !matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    ) {
+        return Ok((Some(state.w.clone()), ev.j));
+    }
+    let w_target = if req == Requirement::Lv {
+        let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
+            "the v-block returned no w-gradient".into(),
+        ))?;
+        let mut wt = state.w.clone();
+        if let Some((h, dw)) =
+            steps::lv_target(k, sigmas, gwj, budget.required_improvement(), certify)?
+        {
+            wt[h] += dw;
+        }
+        Some(wt)
+    } else {
+        None
+    };
+    let j_target = target_j(
+        source,
+        (state.iteration, &state.v, w_target.as_deref(), sizes[1]),
+        counts,
+    )?;
+    if state.target_prev.is_some() {
+        budget
+            .record_target(j_target)
+            .map_err(|_| RunError::NonFinite {
+                what: "budget",
+                iteration: state.iteration,
+            })?;
+    }
+    Ok((w_target, j_target))
 }
 
 /// One half-iteration of alternating SEPG-MI or SEPG-LB-I (the thesis-era code's schedule):
@@ -553,7 +582,7 @@ fn iterate_alternating(
 fn w_plan(
     setup: &Setup,
     sigmas: &[f64],
-    e: &Estimate,
+    e: &BlockEstimate,
     required: f64,
     alpha: f64,
 ) -> Result<Plan, RunError> {
@@ -815,36 +844,13 @@ fn iterate_certified(
     let sigmas = state.sigma();
     // Target block (LV, ZV, SIM-ν): its J is logged; LV's target is guaranteed from the
     // budget at the iteration's start (J(θ_T) ≥ J(θᵗ) − B ≥ J(θ⁰) − B⁰).
-    let mut w_target = Some(state.w.clone());
-    let mut j_target = ev.j;
-    if matches!(
-        req,
-        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
-    ) {
-        w_target = if req == Requirement::Lv {
-            let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
-                "the v-block returned no w-gradient".into(),
-            ))?;
-            let mut wt = state.w.clone();
-            if let Some((h, dw)) = steps::lv_target(k, &sigmas, gwj, allowed(b0), certify)? {
-                if certify {
-                    let b = CoordinateBound::log_sigma(k, sigmas[h], gwj.value[h], gwj.eps[h])
-                        .map_err(bounds)?;
-                    wt[h] = realise(wt[h], dw, &b, allowed(b0), true).value;
-                } else {
-                    wt[h] += dw;
-                }
-            }
-            Some(wt)
-        } else {
-            None
-        };
-        j_target = target_j(
-            source,
-            (t, &state.v, w_target.as_deref(), sizes[1]),
-            (&mut trajectories, &mut env_steps),
-        )?;
-    }
+    let (w_target, j_target) = certified_target(
+        source,
+        setup,
+        (state, &sigmas, &ev, allowed(b0)),
+        &sizes,
+        (&mut trajectories, &mut env_steps),
+    )?;
 
     // w-block (SIM-ν: from the v-block's batch).
     let mut w_new = state.w.clone();
@@ -903,6 +909,51 @@ fn iterate_certified(
     state.steps = env_steps;
     state.last_alpha = Some(alpha);
     Ok(record)
+}
+
+/// The target block of a certified iteration (LV, ZV, SIM-ν; the exploratory policy itself
+/// for the other variants; `sizes` the batch sizes of the iteration's blocks): θ_Tᵗ's log σ (LV: a step of the v-block's ∇̂_w J guaranteed to
+/// lose at most `allowance`, realised; ZV, SIM-ν: none, the deterministic policy) and its J.
+fn certified_target(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    (state, sigmas, ev, allowance): (&State, &[f64], &BlockEstimate, f64),
+    sizes: &[usize],
+    counts: (&mut u64, &mut u64),
+) -> Result<(Option<Vec<f64>>, f64), RunError> {
+    let Setup {
+        k, req, certify, ..
+    } = *setup;
+    if !matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    ) {
+        return Ok((Some(state.w.clone()), ev.j));
+    }
+    let w_target = if req == Requirement::Lv {
+        let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
+            "the v-block returned no w-gradient".into(),
+        ))?;
+        let mut wt = state.w.clone();
+        if let Some((h, dw)) = steps::lv_target(k, sigmas, gwj, allowance, certify)? {
+            if certify {
+                let b = CoordinateBound::log_sigma(k, sigmas[h], gwj.value[h], gwj.eps[h])
+                    .map_err(|e| RunError::Bounds(e.to_string()))?;
+                wt[h] = realise(wt[h], dw, &b, allowance, true).value;
+            } else {
+                wt[h] += dw;
+            }
+        }
+        Some(wt)
+    } else {
+        None
+    };
+    let j_target = target_j(
+        source,
+        (state.iteration, &state.v, w_target.as_deref(), sizes[1]),
+        counts,
+    )?;
+    Ok((w_target, j_target))
 }
 
 #[cfg(test)]

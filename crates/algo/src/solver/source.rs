@@ -30,9 +30,9 @@ pub struct Need {
     /// ∇_w J.
     pub grad_wj: bool,
     /// ∇_w L (surrogate of Corollary 4.4), with the plug-in ingredients of other w-directions
-    /// ([`Estimate::parts`]).
+    /// ([`BlockEstimate::parts`]).
     pub grad_wl: bool,
-    /// A one-sided upper confidence width of Ĵ ([`Estimate::j_width`]).
+    /// A one-sided upper confidence width of Ĵ ([`BlockEstimate::j_width`]).
     pub j_width: bool,
 }
 
@@ -65,7 +65,7 @@ pub(crate) struct Query<'a> {
 
 /// What one block yields: J and the gradients it was asked for.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Estimate {
+pub struct BlockEstimate {
     /// J(θ) (Ĵ, the mean discounted return, when sampled).
     pub j: f64,
     /// ∇_v J if requested.
@@ -88,7 +88,7 @@ pub struct Estimate {
 /// A provider of J and its gradients.
 pub(crate) trait GradientSource: Send {
     /// Evaluates the policy of `q`.
-    fn estimate(&mut self, q: &Query<'_>) -> Result<Estimate, RunError>;
+    fn estimate(&mut self, q: &Query<'_>) -> Result<BlockEstimate, RunError>;
 
     /// The check of the declared constants against the source's data (`None` for exact
     /// sources, which see no data).
