@@ -27,8 +27,8 @@ export PYO3_BUILD_EXTENSION_MODULE=1
 echo "== cargo test --workspace --release"
 cargo test --workspace --release
 
-echo "== maturin develop --release (crates/python)"
-(cd crates/python && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --release --quiet)
+echo "== maturin develop --release --features verify (crates/python)"
+(cd crates/python && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --release --quiet --features verify)
 
 echo "== pytest (crates/python/tests)"
 "$venv/bin/python" -m pytest crates/python/tests -q -p no:cacheprovider

@@ -322,7 +322,8 @@ fn read_sweep_file(path: PathBuf) -> PyResult<String> {
 /// Runs the numerical checks of the thesis's statements (`sepg-verification`, as
 /// `sepg verify`): all, or those whose identifier contains `check`; `quick` runs the CI
 /// subset. Returns the report as a dict (each check's outcome and whether it is the
-/// recorded one).
+/// recorded one). Built with the `verify` feature only.
+#[cfg(feature = "verify")]
 #[pyfunction]
 #[pyo3(signature = (quick = true, check = None, seed = 0))]
 fn verify<'py>(
@@ -340,6 +341,24 @@ fn verify<'py>(
     let config = sepg_verification::RunConfig { seed, quick };
     let report = py.detach(|| sepg_verification::run_checks(&checks, &config, check, |_| {}));
     serialize_to_py(py, &report)
+}
+
+/// Without the `verify` feature (the default wheel, which does not ship the verification
+/// harness): says how to get the checks.
+#[cfg(not(feature = "verify"))]
+#[pyfunction]
+#[pyo3(signature = (quick = true, check = None, seed = 0))]
+fn verify<'py>(
+    py: Python<'py>,
+    quick: bool,
+    check: Option<&str>,
+    seed: u64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let _ = (py, quick, check, seed);
+    Err(failed(
+        "this build of sepg has no verification harness: run `sepg verify`, or build the \
+         package with `maturin develop --release --features verify`",
+    ))
 }
 
 /// Adds the functions of this module to `m`.
