@@ -202,3 +202,46 @@ fn the_readme_says_what_a_guarantee_means() {
     }
     assert!(readme.contains("(docs/RELIABILITY.md)"));
 }
+
+/// The licences the manifests declare ("MIT OR Apache-2.0") are in the repository, with a
+/// citation file for the software and the thesis it implements, and no manifest names a
+/// placeholder repository URL.
+#[test]
+fn the_repository_carries_its_licences_and_citation() {
+    let manifest = read(&root().join("Cargo.toml"));
+    assert!(manifest.contains("license = \"MIT OR Apache-2.0\""));
+    let mit = read(&root().join("LICENSE-MIT"));
+    assert!(mit.starts_with("MIT License") && mit.contains("Permission is hereby granted"));
+    let apache = read(&root().join("LICENSE-APACHE"));
+    assert!(apache.contains("Apache License") && apache.contains("Version 2.0, January 2004"));
+    let cff = read(&root().join("CITATION.cff"));
+    assert!(cff.contains("cff-version: 1.2.0"), "{cff}");
+    assert!(cff.contains("Balancing Safety and Exploration in Policy Gradient"));
+    assert!(cff.contains("Politecnico di Milano") && cff.contains("type: thesis"));
+    let mut manifests = vec![root().join("Cargo.toml")];
+    for dir in ["crates", "."] {
+        for entry in std::fs::read_dir(root().join(dir)).expect("read_dir") {
+            let path = entry.expect("entry").path().join("Cargo.toml");
+            if path.is_file() {
+                manifests.push(path);
+            }
+        }
+    }
+    assert!(manifests.len() >= 9, "{manifests:?}");
+    for m in manifests {
+        assert!(!read(&m).contains("example.invalid"), "{}", m.display());
+    }
+}
+
+/// The README says how to put the binary on the PATH, and its budget example says what
+/// `sepg bounds` does with `--required` (each update's requirement, split only with `--nu`).
+#[test]
+fn the_readme_installs_the_binary_and_states_the_budget_split() {
+    let readme = read(&root().join("README.md"));
+    assert!(readme.contains("cargo install --path ."));
+    assert!(
+        readme.contains("without `--nu`"),
+        "the budget example must name --nu"
+    );
+    assert!(readme.contains("`--required -0.5 --nu 0.5` gives −0.25 to each update"));
+}
