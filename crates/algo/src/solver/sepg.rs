@@ -369,14 +369,18 @@ pub(crate) fn iterate(
     let v_log = BlockLog::from_plan(&v_plan);
 
     // Target block (LV, ZV, SIM-ν): evaluate θ_Tᵗ = (vᵗ, w_T) and update the budget (line 12).
-    let (w_target, j_target) = estimated_target(
+    // LV's target takes the step of (4.17) for the budget's requirement, unrealised.
+    let (w_target, j_target) = target_block(
         source,
         setup,
         (state, &sigmas, &ev),
-        &mut budget,
+        (budget.required_improvement(), false),
         &sizes,
         (&mut trajectories, &mut env_steps),
     )?;
+    if has_target(req) && state.target_prev.is_some() {
+        budget.record_target(j_target).map_err(budget_error)?;
+    }
 
     // w-block.
     let mut w_new = state.w.clone();
@@ -426,68 +430,13 @@ pub(crate) fn iterate(
     state.budget = budget.value();
     state.j0 = j0;
     state.pending = Some(pending);
-    if matches!(
-        req,
-        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
-    ) {
+    if has_target(req) {
         state.target_prev = Some(j_target);
     }
     state.trajectories = trajectories;
     state.steps = env_steps;
     state.last_alpha = Some(alpha);
     Ok(record)
-}
-
-/// The target block of an iteration with the thesis's bookkeeping (LV, ZV, SIM-ν; the
-/// exploratory policy itself for the other variants; `sizes` the batch sizes of the
-/// iteration's blocks): θ_Tᵗ's log σ (LV: the step of (4.17) for the budget's requirement;
-/// ZV, SIM-ν: none, the deterministic policy) and its J, recorded in `budget` (line 12 of
-/// Algorithm 4.3).
-fn estimated_target(
-    source: &mut dyn GradientSource,
-    setup: &Setup,
-    (state, sigmas, ev): (&State, &[f64], &BlockEstimate),
-    budget: &mut Budget,
-    sizes: &[usize],
-    counts: (&mut u64, &mut u64),
-) -> Result<(Option<Vec<f64>>, f64), RunError> {
-    let Setup {
-        k, req, certify, ..
-    } = *setup;
-    if !matches!(
-        req,
-        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
-    ) {
-        return Ok((Some(state.w.clone()), ev.j));
-    }
-    let w_target = if req == Requirement::Lv {
-        let gwj = ev.grad_wj.as_ref().ok_or(RunError::Estimator(
-            "the v-block returned no w-gradient".into(),
-        ))?;
-        let mut wt = state.w.clone();
-        if let Some((h, dw)) =
-            steps::lv_target(k, sigmas, gwj, budget.required_improvement(), certify)?
-        {
-            wt[h] += dw;
-        }
-        Some(wt)
-    } else {
-        None
-    };
-    let j_target = target_j(
-        source,
-        (state.iteration, &state.v, w_target.as_deref(), sizes[1]),
-        counts,
-    )?;
-    if state.target_prev.is_some() {
-        budget
-            .record_target(j_target)
-            .map_err(|_| RunError::NonFinite {
-                what: "budget",
-                iteration: state.iteration,
-            })?;
-    }
-    Ok((w_target, j_target))
 }
 
 /// One half-iteration of alternating SEPG-MI or SEPG-LB-I (the thesis-era code's schedule):
@@ -844,10 +793,11 @@ fn iterate_certified(
     let sigmas = state.sigma();
     // Target block (LV, ZV, SIM-ν): its J is logged; LV's target is guaranteed from the
     // budget at the iteration's start (J(θ_T) ≥ J(θᵗ) − B ≥ J(θ⁰) − B⁰).
-    let (w_target, j_target) = certified_target(
+    let (w_target, j_target) = target_block(
         source,
         setup,
-        (state, &sigmas, &ev, allowed(b0)),
+        (state, &sigmas, &ev),
+        (allowed(b0), setup.certify),
         &sizes,
         (&mut trajectories, &mut env_steps),
     )?;
@@ -911,23 +861,31 @@ fn iterate_certified(
     Ok(record)
 }
 
-/// The target block of a certified iteration (LV, ZV, SIM-ν; the exploratory policy itself
-/// for the other variants; `sizes` the batch sizes of the iteration's blocks): θ_Tᵗ's log σ (LV: a step of the v-block's ∇̂_w J guaranteed to
-/// lose at most `allowance`, realised; ZV, SIM-ν: none, the deterministic policy) and its J.
-fn certified_target(
+/// Whether the variant evaluates a target policy θ_Tᵗ (LV, ZV, SIM-ν).
+fn has_target(req: Requirement) -> bool {
+    matches!(
+        req,
+        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
+    )
+}
+
+/// The target block of an iteration (LV, ZV, SIM-ν; the exploratory policy itself for the
+/// other variants; `sizes` the batch sizes of the iteration's blocks): θ_Tᵗ's log σ and its J.
+/// LV's target is a step along the v-block's ∇̂_w J that may lose at most `allowance`
+/// (the budget's requirement), applied as it is or, with `realised`, through the certificate
+/// of the rounded update; ZV's and SIM-ν's is the deterministic policy.
+fn target_block(
     source: &mut dyn GradientSource,
     setup: &Setup,
-    (state, sigmas, ev, allowance): (&State, &[f64], &BlockEstimate, f64),
+    (state, sigmas, ev): (&State, &[f64], &BlockEstimate),
+    (allowance, realised): (f64, bool),
     sizes: &[usize],
     counts: (&mut u64, &mut u64),
 ) -> Result<(Option<Vec<f64>>, f64), RunError> {
     let Setup {
         k, req, certify, ..
     } = *setup;
-    if !matches!(
-        req,
-        Requirement::Lv | Requirement::Zv | Requirement::Sim { .. }
-    ) {
+    if !has_target(req) {
         return Ok((Some(state.w.clone()), ev.j));
     }
     let w_target = if req == Requirement::Lv {
@@ -936,7 +894,7 @@ fn certified_target(
         ))?;
         let mut wt = state.w.clone();
         if let Some((h, dw)) = steps::lv_target(k, sigmas, gwj, allowance, certify)? {
-            if certify {
+            if realised {
                 let b = CoordinateBound::log_sigma(k, sigmas[h], gwj.value[h], gwj.eps[h])
                     .map_err(|e| RunError::Bounds(e.to_string()))?;
                 wt[h] = realise(wt[h], dw, &b, allowance, true).value;
