@@ -2,7 +2,7 @@
 //! determinism across thread counts, and the bad-input contract.
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::Duration;
 
 use rand::{Rng, SeedableRng};
@@ -212,6 +212,34 @@ fn wait_for_checkpoint(child: &mut Child, dir: &Path, k: u64) {
     }
 }
 
+/// Starts `sepg` with `args` and `--checkpoint-every 100`, sends `signal` (a `kill` flag) once
+/// the run in `dir` has checkpointed iteration `k`, and returns its output after asserting
+/// that it stopped with exit status 1 and no summary.
+fn signal_after_checkpoint(args: Vec<String>, dir: &Path, k: u64, signal: &str) -> Output {
+    let args = [args, vec!["--checkpoint-every".into(), "100".into()]].concat();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    wait_for_checkpoint(&mut child, dir, k);
+    let status = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!dir.join("summary.json").exists());
+    out
+}
+
 fn assert_same_run(a: &Path, b: &Path) {
     assert_eq!(
         std::fs::read(a.join("log.csv")).expect("log"),
@@ -310,34 +338,10 @@ fn signal_checkpoints_and_resumes_bit_identically(signal: &str) {
     let reference = tmp.path().join("reference");
     sepg_ok(&readme_run(&reference, 3000));
     let dir = tmp.path().join("interrupted");
-    let args = [
-        readme_run(&dir, 3000),
-        vec!["--checkpoint-every".into(), "100".into()],
-    ]
-    .concat();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
     // The handler is installed before the run folder is created, so a checkpoint means it is
     // in place. 2,700 iterations are then left (about 0.17 s of CPU time), far more than
     // sending the signal takes, so the run cannot end first.
-    wait_for_checkpoint(&mut child, &dir, 300);
-    let status = Command::new("kill")
-        .args([signal, &child.id().to_string()])
-        .status()
-        .expect("kill");
-    assert!(status.success());
-    let out = child.wait_with_output().expect("wait");
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(!dir.join("summary.json").exists());
+    let out = signal_after_checkpoint(readme_run(&dir, 3000), &dir, 300, signal);
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert_eq!(err.lines().count(), 1, "{err:?}");
     assert!(
@@ -989,33 +993,9 @@ fn a_safe_adam_run_resumes_bit_identically() {
     let reference = tmp.path().join("reference");
     sepg_ok(&safe_adam_args(&reference, "3000"));
     let dir = tmp.path().join("interrupted");
-    let args = [
-        safe_adam_args(&dir, "3000"),
-        vec!["--checkpoint-every".into(), "100".into()],
-    ]
-    .concat();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
     // About 1 ms of CPU time per exact iteration: 2,900 iterations are left after the
     // checkpoint of iteration 100, far more than sending the signal takes.
-    wait_for_checkpoint(&mut child, &dir, 100);
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill");
-    assert!(status.success());
-    let out = child.wait_with_output().expect("wait");
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(!dir.join("summary.json").exists());
+    signal_after_checkpoint(safe_adam_args(&dir, "3000"), &dir, 100, "-INT");
     resume(&dir);
     assert_same_run(&reference, &dir);
     assert_eq!(
