@@ -323,7 +323,7 @@ impl Checker {
     pub(crate) fn scan_batch(&mut self, batch: &Batch, at: At) -> Option<Offence> {
         let limits = self.limits?;
         let before = self.tally.first.is_some();
-        let (r_max, slack) = (limits.r_max, limits.r_max * SLACK);
+        let slack = limits.r_max * SLACK;
         // γᵗ as the rollout engine computes it, and the bound fl(γᵗ · R_max · SLACK) of each
         // step; a step whose γᵗ is 0 is not checked.
         self.discs.clear();
@@ -354,15 +354,14 @@ impl Checker {
             }
             let steps = row[..len].iter().zip(&self.discs).zip(&self.bounds);
             for (t, ((&dr, &disc), &bound)) in steps.enumerate() {
-                if dr.abs() > bound {
-                    self.tally.count(Constant::RMax, || {
-                        offence(at, Constant::RMax, dr / disc, r_max, i, t)
-                    });
-                } else if sign && dr > 0.0 {
-                    self.tally.count(Constant::RewardSign, || {
-                        offence(at, Constant::RewardSign, dr / disc, 0.0, i, t)
-                    });
-                }
+                Self::count_reward(
+                    &mut self.tally,
+                    at,
+                    (i, t),
+                    dr / disc,
+                    dr.abs() > bound,
+                    &limits,
+                );
             }
         }
         self.new_first(before)
@@ -391,15 +390,7 @@ impl Checker {
                     break;
                 };
                 self.tally.rewards_checked += 1;
-                if r.abs() > r_max {
-                    self.tally.count(Constant::RMax, || {
-                        offence(at, Constant::RMax, r, limits.r_max, i, t)
-                    });
-                } else if limits.non_positive && r > 0.0 {
-                    self.tally.count(Constant::RewardSign, || {
-                        offence(at, Constant::RewardSign, r, 0.0, i, t)
-                    });
-                }
+                Self::count_reward(&mut self.tally, at, (i, t), r, r.abs() > r_max, &limits);
                 let Some(phi) = steps.features.get(c * p..(c + 1) * p).filter(|_| p > 0) else {
                     continue;
                 };
@@ -420,6 +411,28 @@ impl Checker {
             }
         }
         self.new_first(before)
+    }
+
+    /// Counts the reward `value` at step `t` of trajectory `i`: beyond R_max when `beyond`
+    /// (decided by the caller with its slack), otherwise positive where the rewards are
+    /// declared non-positive.
+    fn count_reward(
+        tally: &mut ConstantsCheck,
+        at: At,
+        (i, t): (usize, usize),
+        value: f64,
+        beyond: bool,
+        limits: &Limits,
+    ) {
+        if beyond {
+            tally.count(Constant::RMax, || {
+                offence(at, Constant::RMax, value, limits.r_max, i, t)
+            });
+        } else if limits.non_positive && value > 0.0 {
+            tally.count(Constant::RewardSign, || {
+                offence(at, Constant::RewardSign, value, 0.0, i, t)
+            });
+        }
     }
 
     fn new_first(&self, before: bool) -> Option<Offence> {
