@@ -10,7 +10,7 @@ use crate::core::state::State;
 use sepg_bounds::budget::Budget;
 use sepg_bounds::constants::TaskConstants;
 
-use crate::solver::source::{Grad, GradientSource, Need, Query};
+use crate::solver::source::{BlockEstimate, Grad, GradientSource, Need, Query};
 use crate::solver::steps;
 
 /// Runs iteration `state.iteration` of a comparison algorithm (`algorithm` must not be a
@@ -23,24 +23,7 @@ pub(crate) fn iterate(
     state: &mut State,
 ) -> Result<Record, RunError> {
     let t = state.iteration;
-    let fixed_sigma = match algorithm {
-        Algorithm::GpomdpConst { beta, .. } => beta == 0.0,
-        Algorithm::GpomdpAdam { lr_w, .. } => lr_w == 0.0,
-        _ => true,
-    };
-    let e = source.estimate(&Query {
-        iteration: t,
-        block: Block::V,
-        v: &state.v,
-        w: Some(&state.w),
-        n,
-        need: Need {
-            grad_v: true,
-            grad_wj: !fixed_sigma,
-            grad_wl: false,
-            j_width: false,
-        },
-    })?;
+    let e = batch(source, algorithm, n, state)?;
     let missing = || RunError::Estimator("the block returned no gradient".into());
     let gv = e.grad_v.as_ref().ok_or_else(missing)?;
     let mut v_new = state.v.clone();
@@ -61,8 +44,66 @@ pub(crate) fn iterate(
         });
     }
     let budget = logged_budget(state, e.j, t)?;
-    let record = Record {
-        iteration: t,
+    let record = record(
+        state,
+        &e,
+        budget,
+        (alpha, beta),
+        (guaranteed_v, below_noise_v),
+    );
+    state.iteration += 1;
+    state.v = v_new;
+    state.w = w_new;
+    state.adam = adam;
+    state.budget = budget;
+    state.j0.get_or_insert(e.j);
+    state.pending = Some(e.j);
+    state.trajectories = record.trajectories;
+    state.steps = record.steps;
+    Ok(record)
+}
+
+/// The single batch of iteration `state.iteration` of `algorithm`: `n` trajectories at
+/// (vᵗ, wᵗ) estimating J and ∇_v J, and ∇_w J unless the algorithm keeps σ fixed (a zero
+/// w-step size).
+fn batch(
+    source: &mut dyn GradientSource,
+    algorithm: Algorithm,
+    n: usize,
+    state: &State,
+) -> Result<BlockEstimate, RunError> {
+    let fixed_sigma = match algorithm {
+        Algorithm::GpomdpConst { beta, .. } => beta == 0.0,
+        Algorithm::GpomdpAdam { lr_w, .. } => lr_w == 0.0,
+        _ => true,
+    };
+    source.estimate(&Query {
+        iteration: state.iteration,
+        block: Block::V,
+        v: &state.v,
+        w: Some(&state.w),
+        n,
+        need: Need {
+            grad_v: true,
+            grad_wj: !fixed_sigma,
+            grad_wl: false,
+            j_width: false,
+        },
+    })
+}
+
+/// The record of an iteration at the state before it, from its batch `e`, the logged
+/// `budget`, the step sizes (α, β), and the adaptive step's guaranteed improvement and
+/// whether it was below noise.
+fn record(
+    state: &State,
+    e: &BlockEstimate,
+    budget: f64,
+    (alpha, beta): (f64, f64),
+    (guaranteed_v, below_noise_v): (Option<f64>, bool),
+) -> Record {
+    Record {
+        iteration: state.iteration,
         v: state.v.clone(),
         w: state.w.clone(),
         sigma: state.sigma(),
@@ -87,17 +128,7 @@ pub(crate) fn iterate(
         steps: state.steps + e.steps,
         certified_v: None,
         certified_w: None,
-    };
-    state.iteration += 1;
-    state.v = v_new;
-    state.w = w_new;
-    state.adam = adam;
-    state.budget = budget;
-    state.j0.get_or_insert(e.j);
-    state.pending = Some(e.j);
-    state.trajectories = record.trajectories;
-    state.steps = record.steps;
-    Ok(record)
+    }
 }
 
 /// The step of `algorithm` from the estimates `(∇̂_v J, ∇̂_w J)`, applied to `(v, w)`: returns

@@ -134,6 +134,35 @@ struct Row {
     steps: u64,
 }
 
+impl Row {
+    /// The row of iteration `state.iteration` at θᵗ = (`state.v`, `state.w`) with σ =
+    /// `sigma`, Ĵ(θᵗ) = `j_exploratory` and the target's `j_target` and `w_target`; the other
+    /// fields as the state holds them before the iteration (no requirement, no Ĵ(vᵗ⁺¹, wᵗ)).
+    fn start(
+        state: &State,
+        sigma: Vec<f64>,
+        j_exploratory: f64,
+        j_target: f64,
+        w_target: Option<Vec<f64>>,
+    ) -> Self {
+        Row {
+            iteration: state.iteration,
+            v: state.v.clone(),
+            w: state.w.clone(),
+            sigma,
+            j_exploratory,
+            j_after_v: None,
+            j_target,
+            w_target,
+            budget: state.budget,
+            required_v: None,
+            required_w: None,
+            trajectories: state.trajectories,
+            steps: state.steps,
+        }
+    }
+}
+
 /// The record of an iteration from its row and the logs of its v- and w-blocks.
 fn record(row: Row, v_log: BlockLog, w_log: BlockLog) -> Record {
     Record {
@@ -297,13 +326,7 @@ pub(crate) fn iterate(
     setup: &Setup,
     state: &mut State,
 ) -> Result<Record, RunError> {
-    let Setup {
-        req,
-        naive_w,
-        n,
-        opts,
-        ..
-    } = *setup;
+    let Setup { req, n, opts, .. } = *setup;
     if opts.accounting == Accounting::Certified {
         return iterate_certified(source, setup, state);
     }
@@ -313,16 +336,8 @@ pub(crate) fn iterate(
     }
     let t = state.iteration;
     let sizes = split(n, req.blocks());
-    let budget_error = |_| RunError::NonFinite {
-        what: "budget",
-        iteration: t,
-    };
     let mut j0 = state.j0;
     let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
-    let sim_nu = match req {
-        Requirement::Sim { nu } => Some(nu),
-        _ => None,
-    };
 
     // v-block: J(vᵗ, wᵗ) and ∇_v J (plus the w-gradients SIM-ν and LV need from this batch).
     let ev = v_block(
@@ -333,38 +348,10 @@ pub(crate) fn iterate(
     )?;
     let j_t = ev.j;
     let j_base = *j0.get_or_insert(j_t);
-    // The budget B (Definition 4.3) measures differences from the last J of each tracked
-    // policy; the delayed w-budget update of the previous iteration comes first (Sec 4.4.4).
-    let mut budget = Budget::new(
-        state.budget,
-        state.pending.unwrap_or(j_t),
-        state.target_prev,
-    )
-    .map_err(budget_error)?;
-    if state.pending.is_some() {
-        budget.record_exploratory(j_t).map_err(budget_error)?;
-    }
-
+    let mut budget = opening_budget(state, j_t)?;
     let sigmas = state.sigma();
-    // Type-I requirement Cᵗ (Table 4.1) split (1 − ν)C / νC (eqs. 4.13, 4.14); SIM-ν splits
-    // the budget νB / (1 − ν)B (Sec 5.1.3); other type-II updates use C = −B.
-    // With `Lb1Requirement::Full` the v-update gets all of Cᵗ and the w-update its own
-    // requirement J(θ⁰) − J(vᵗ⁺¹, wᵗ), measured by the w-block.
-    let full = opts.lb1_requirement == Lb1Requirement::Full;
-    let type_one = match req {
-        Requirement::Mi => Some(split_requirement(0.0, 0.0)),
-        Requirement::LbI { nu } => {
-            Some(split_requirement(j_base - j_t, if full { 0.0 } else { nu }))
-        }
-        _ => None,
-    }
-    .transpose()
-    .map_err(|e| RunError::Bounds(e.to_string()))?;
-    let required_v = match (type_one, sim_nu) {
-        (Some((cv, _)), _) => cv,
-        (None, Some(nu)) => -nu * budget.value(),
-        (None, None) => budget.required_improvement(),
-    };
+    let type_one = type_one_split(req, opts.lb1_requirement, j_base - j_t)?;
+    let required_v = estimated_required_v(req, type_one, &budget);
     let (v_plan, v_new, alpha) = v_update(setup, &state.v, &state.w, &ev, required_v)?;
     let v_log = BlockLog::from_plan(&v_plan);
 
@@ -379,64 +366,167 @@ pub(crate) fn iterate(
         (&mut trajectories, &mut env_steps),
     )?;
     if has_target(req) && state.target_prev.is_some() {
-        budget.record_target(j_target).map_err(budget_error)?;
+        budget.record_target(j_target).map_err(budget_error(t))?;
     }
+    let wu = estimated_w_update(
+        source,
+        setup,
+        (state, &sigmas, &ev, &v_new),
+        (type_one, j_base, alpha, sizes[sizes.len() - 1]),
+        &mut budget,
+        (&mut trajectories, &mut env_steps),
+    )?;
 
-    // w-block.
-    let mut w_new = state.w.clone();
-    let (j_after_v, required_w, w_log, pending) = if let Some(nu) = sim_nu {
-        let required_w = -(1.0 - nu) * budget.value();
-        let plan = w_plan(setup, &sigmas, &ev, required_w, alpha)?;
-        apply(&mut w_new, &plan);
-        (None, required_w, BlockLog::from_plan(&plan), j_t)
-    } else {
-        let ew = w_block(
-            source,
-            naive_w,
-            (t, &v_new, &state.w, sizes[sizes.len() - 1]),
-            (&mut trajectories, &mut env_steps),
-        )?;
-        // Delayed v-budget update, right after J(vᵗ⁺¹, wᵗ) is known (Sec 4.4.4).
-        budget.record_exploratory(ew.j).map_err(budget_error)?;
-        let required_w = match (req, full) {
-            (Requirement::LbI { .. }, true) => j_base - ew.j,
-            _ => type_one.map_or(budget.required_improvement(), |(_, cw)| cw),
-        };
-        let plan = w_plan(setup, &sigmas, &ew, required_w, alpha)?;
-        apply(&mut w_new, &plan);
-        (Some(ew.j), required_w, BlockLog::from_plan(&plan), ew.j)
-    };
-
-    check_finite(&v_new, &w_new, t)?;
-    let row = Row {
-        iteration: t,
-        v: state.v.clone(),
-        w: state.w.clone(),
-        sigma: sigmas,
-        j_exploratory: j_t,
-        j_after_v,
-        j_target,
-        w_target,
-        budget: budget.value(),
-        required_v: Some(required_v),
-        required_w: Some(required_w),
-        trajectories,
-        steps: env_steps,
-    };
-    let record = record(row, v_log, w_log);
-    state.iteration += 1;
-    state.v = v_new;
-    state.w = w_new;
-    state.budget = budget.value();
+    check_finite(&v_new, &wu.w_new, t)?;
+    let mut row = Row::start(state, sigmas, ev.j, j_target, w_target);
+    row.j_after_v = wu.j_after_v;
+    row.budget = budget.value();
+    row.required_v = Some(required_v);
+    row.required_w = Some(wu.required_w);
+    row.trajectories = trajectories;
+    row.steps = env_steps;
+    let record = record(row, v_log, wu.log);
+    advance(state, (v_new, wu.w_new), budget.value(), &record, alpha);
     state.j0 = j0;
-    state.pending = Some(pending);
+    state.pending = Some(wu.pending);
     if has_target(req) {
         state.target_prev = Some(j_target);
     }
-    state.trajectories = trajectories;
-    state.steps = env_steps;
-    state.last_alpha = Some(alpha);
     Ok(record)
+}
+
+/// The error of a budget update of iteration `iteration` that would leave B non-finite.
+fn budget_error<E>(iteration: u64) -> impl Fn(E) -> RunError {
+    move |_| RunError::NonFinite {
+        what: "budget",
+        iteration,
+    }
+}
+
+/// The budget B (Definition 4.3) at the start of an iteration of the thesis's accounting
+/// whose exploratory J estimate is `j_t`. B measures differences from the last J of each
+/// tracked policy; the delayed w-budget update of the previous iteration comes first
+/// (Sec 4.4.4).
+fn opening_budget(state: &State, j_t: f64) -> Result<Budget, RunError> {
+    let t = state.iteration;
+    let mut budget = Budget::new(
+        state.budget,
+        state.pending.unwrap_or(j_t),
+        state.target_prev,
+    )
+    .map_err(budget_error(t))?;
+    if state.pending.is_some() {
+        budget.record_exploratory(j_t).map_err(budget_error(t))?;
+    }
+    Ok(budget)
+}
+
+/// The type-I requirement Cᵗ (Table 4.1) split (1 − ν)C / νC between the v- and w-steps
+/// (eqs. 4.13, 4.14): MI requires 0 of each; LB-I requires `lb1_gap` = J(θ⁰) − Ĵ(θᵗ) of the
+/// two (all of it to the v-step with [`Lb1Requirement::Full`], the w-step then measuring its
+/// own); `None` for the type-II requirements.
+fn type_one_split(
+    req: Requirement,
+    lb1: Lb1Requirement,
+    lb1_gap: f64,
+) -> Result<Option<(f64, f64)>, RunError> {
+    let full = lb1 == Lb1Requirement::Full;
+    match req {
+        Requirement::Mi => Some(split_requirement(0.0, 0.0)),
+        Requirement::LbI { nu } => Some(split_requirement(lb1_gap, if full { 0.0 } else { nu })),
+        _ => None,
+    }
+    .transpose()
+    .map_err(|e| RunError::Bounds(e.to_string()))
+}
+
+/// The v-step's requirement under the thesis's accounting: the type-I share, SIM-ν's −νB
+/// (Sec 5.1.3), or −B for the other type-II requirements.
+fn estimated_required_v(req: Requirement, type_one: Option<(f64, f64)>, budget: &Budget) -> f64 {
+    match (type_one, req) {
+        (Some((cv, _)), _) => cv,
+        (None, Requirement::Sim { nu }) => -nu * budget.value(),
+        (None, _) => budget.required_improvement(),
+    }
+}
+
+/// The outcome of the w-block of an iteration of the thesis's accounting.
+struct WUpdate {
+    /// wᵗ⁺¹.
+    w_new: Vec<f64>,
+    /// Ĵ(vᵗ⁺¹, wᵗ), measured by the w-block (`None` for SIM-ν, which has none).
+    j_after_v: Option<f64>,
+    /// The w-step's requirement.
+    required_w: f64,
+    /// The w-block's log.
+    log: BlockLog,
+    /// The J whose successor the next iteration's delayed budget update measures.
+    pending: f64,
+}
+
+/// The w-block of an iteration of the thesis's accounting, after the v-step to `v_new`:
+/// SIM-ν steps from the v-block's batch for −(1 − ν)B; the others estimate at (vᵗ⁺¹, wᵗ)
+/// from `n_w` trajectories, apply the delayed v-budget update right after J(vᵗ⁺¹, wᵗ) is
+/// known (Sec 4.4.4), and step for the type-I share (`type_one`), LB-I's own
+/// J(θ⁰) − Ĵ(vᵗ⁺¹, wᵗ) with [`Lb1Requirement::Full`], or −B.
+fn estimated_w_update(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    (state, sigmas, ev, v_new): (&State, &[f64], &BlockEstimate, &[f64]),
+    (type_one, j_base, alpha, n_w): (Option<(f64, f64)>, f64, f64, usize),
+    budget: &mut Budget,
+    counts: (&mut u64, &mut u64),
+) -> Result<WUpdate, RunError> {
+    let mut w_new = state.w.clone();
+    if let Requirement::Sim { nu } = setup.req {
+        let required_w = -(1.0 - nu) * budget.value();
+        let plan = w_plan(setup, sigmas, ev, required_w, alpha)?;
+        apply(&mut w_new, &plan);
+        let log = BlockLog::from_plan(&plan);
+        let (j_after_v, pending) = (None, ev.j);
+        return Ok(WUpdate {
+            w_new,
+            j_after_v,
+            required_w,
+            log,
+            pending,
+        });
+    }
+    let t = state.iteration;
+    let ew = w_block(source, setup.naive_w, (t, v_new, &state.w, n_w), counts)?;
+    budget.record_exploratory(ew.j).map_err(budget_error(t))?;
+    let full = setup.opts.lb1_requirement == Lb1Requirement::Full;
+    let required_w = match (setup.req, full) {
+        (Requirement::LbI { .. }, true) => j_base - ew.j,
+        _ => type_one.map_or(budget.required_improvement(), |(_, cw)| cw),
+    };
+    let plan = w_plan(setup, sigmas, &ew, required_w, alpha)?;
+    apply(&mut w_new, &plan);
+    Ok(WUpdate {
+        w_new,
+        j_after_v: Some(ew.j),
+        required_w,
+        log: BlockLog::from_plan(&plan),
+        pending: ew.j,
+    })
+}
+
+/// Moves `state` past the iteration that produced `record`: θᵗ⁺¹ = `(v, w)`, the budget, the
+/// counts of the record and the v-step size `alpha`.
+fn advance(
+    state: &mut State,
+    (v, w): (Vec<f64>, Vec<f64>),
+    budget: f64,
+    record: &Record,
+    alpha: f64,
+) {
+    state.iteration += 1;
+    state.v = v;
+    state.w = w;
+    state.budget = budget;
+    state.trajectories = record.trajectories;
+    state.steps = record.steps;
+    state.last_alpha = Some(alpha);
 }
 
 /// One half-iteration of alternating SEPG-MI or SEPG-LB-I (the thesis-era code's schedule):
@@ -716,23 +806,10 @@ fn iterate_certified(
     setup: &Setup,
     state: &mut State,
 ) -> Result<Record, RunError> {
-    let Setup {
-        k,
-        req,
-        naive_w,
-        n,
-        opts,
-        certify,
-        ..
-    } = *setup;
+    let Setup { req, n, .. } = *setup;
     let t = state.iteration;
     let sizes = split(n, req.blocks());
     let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
-    let sim_nu = match req {
-        Requirement::Sim { nu } => Some(nu),
-        _ => None,
-    };
-    let sim = sim_nu.is_some();
     // LB-I's surplus starts at 0 whatever B⁰ (its requirement is J ≥ J(θ⁰), Table 4.1); the
     // type-II budgets start at B⁰
     let b0 = if t == 0 && matches!(req, Requirement::LbI { .. }) {
@@ -740,15 +817,7 @@ fn iterate_certified(
     } else {
         state.budget
     };
-    let (cv, cw) = match (req, opts.lb1_requirement) {
-        (Requirement::Mi, _) => (0.0, 0.0),
-        (Requirement::LbI { nu }, Lb1Requirement::Split) => split_down(b0, nu),
-        (Requirement::Sim { nu }, _) => {
-            let (rest, v_share) = split_down(b0, nu);
-            (v_share, rest)
-        }
-        _ => (b0, f64::NAN),
-    };
+    let (cv, cw) = certified_shares(req, setup.opts.lb1_requirement, b0);
     let required_v = allowed(cv);
 
     let ev = v_block(
@@ -757,37 +826,8 @@ fn iterate_certified(
         (t, &state.v, &state.w, sizes[0]),
         (&mut trajectories, &mut env_steps),
     )?;
-    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
-        "the v-block returned no gradient".into(),
-    ))?;
-    let sigma_v = min_sigma(&state.w);
     let mut v_new = state.v.clone();
-    let bounds = |e: sepg_bounds::BoundsError| RunError::Bounds(e.to_string());
-    let (v_log, g_v, alpha) = match opts.v_direction {
-        VDirection::Greedy => {
-            let v_plan = steps::v_step(k, sigma_v, grad_v, required_v, certify)?;
-            let eps_v = eps_max(grad_v);
-            apply_realised(
-                &mut v_new,
-                &v_plan,
-                |i| CoordinateBound::mean(k, sigma_v, grad_v.value[i], eps_v).map_err(bounds),
-                required_v,
-                certify,
-            )?
-        }
-        VDirection::Adam {
-            lr,
-            beta1,
-            beta2,
-            eps,
-        } => {
-            let moments = state
-                .adam_v
-                .get_or_insert_with(|| AdamMoments::zeros(grad_v.value.len()));
-            let u = moments.step(&grad_v.value, lr, beta1, beta2, eps);
-            along_direction(setup, sigma_v, grad_v, &u, required_v, &mut v_new)?
-        }
-    };
+    let (v_log, g_v, alpha) = certified_v_update(setup, state, &ev, required_v, &mut v_new)?;
     let b1 = add_down(b0, g_v);
 
     let sigmas = state.sigma();
@@ -803,62 +843,131 @@ fn iterate_certified(
     )?;
 
     // w-block (SIM-ν: from the v-block's batch).
-    let mut w_new = state.w.clone();
     let required_w = if cw.is_nan() {
         allowed(b1)
     } else {
         allowed(cw)
     };
-    let (j_after_v, ew) = if sim {
-        (None, None)
-    } else {
-        let ew = w_block(
-            source,
-            naive_w,
-            (t, &v_new, &state.w, sizes[sizes.len() - 1]),
-            (&mut trajectories, &mut env_steps),
-        )?;
-        (Some(ew.j), Some(ew))
-    };
-    let e_w = ew.as_ref().unwrap_or(&ev);
-    let gj = e_w.grad_wj.as_ref().ok_or(RunError::Estimator(
-        "the w-block returned no w-gradient".into(),
-    ))?;
-    let w_plan = w_plan(setup, &sigmas, e_w, required_w, alpha)?;
-    let (w_log, g_w, _) = apply_realised(
+    let mut w_new = state.w.clone();
+    let (j_after_v, w_log, g_w) = certified_w_update(
+        source,
+        setup,
+        (state, &sigmas, &ev, &v_new),
+        (required_w, alpha, sizes[sizes.len() - 1]),
         &mut w_new,
-        &w_plan,
-        |h| CoordinateBound::log_sigma(k, sigmas[h], gj.value[h], gj.eps[h]).map_err(bounds),
-        required_w,
-        certify,
+        (&mut trajectories, &mut env_steps),
     )?;
     let b2 = add_down(b1, g_w);
 
     check_finite(&v_new, &w_new, t)?;
-    let row = Row {
-        iteration: t,
-        v: state.v.clone(),
-        w: state.w.clone(),
-        sigma: sigmas,
-        j_exploratory: ev.j,
-        j_after_v,
-        j_target,
-        w_target,
-        budget: b2,
-        required_v: Some(required_v),
-        required_w: Some(required_w),
-        trajectories,
-        steps: env_steps,
-    };
+    let mut row = Row::start(state, sigmas, ev.j, j_target, w_target);
+    row.j_after_v = j_after_v;
+    row.budget = b2;
+    row.required_v = Some(required_v);
+    row.required_w = Some(required_w);
+    row.trajectories = trajectories;
+    row.steps = env_steps;
     let record = record(row, v_log, w_log);
-    state.iteration += 1;
-    state.v = v_new;
-    state.w = w_new;
-    state.budget = b2;
-    state.trajectories = trajectories;
-    state.steps = env_steps;
-    state.last_alpha = Some(alpha);
+    advance(state, (v_new, w_new), b2, &record, alpha);
     Ok(record)
+}
+
+/// The allowances (v-step, w-step) of the certified accounting out of the budget `b0` at
+/// the iteration's start: MI none; LB-I with [`Lb1Requirement::Split`] (1 − ν)B and νB;
+/// SIM-ν νB and (1 − ν)B; the others all of B to the v-step and NaN for the w-step, whose
+/// allowance is then the budget after the v-step.
+fn certified_shares(req: Requirement, lb1: Lb1Requirement, b0: f64) -> (f64, f64) {
+    match (req, lb1) {
+        (Requirement::Mi, _) => (0.0, 0.0),
+        (Requirement::LbI { nu }, Lb1Requirement::Split) => split_down(b0, nu),
+        (Requirement::Sim { nu }, _) => {
+            let (rest, v_share) = split_down(b0, nu);
+            (v_share, rest)
+        }
+        _ => (b0, f64::NAN),
+    }
+}
+
+/// The v-step of the certified accounting from the v-block's estimate `ev`, applied to
+/// `v_new` (a copy of vᵗ): greedy (Theorem 4.2 on the best coordinate) or along Adam's
+/// direction (whose moments live in `state`), realised and certified again. Returns the
+/// block log, the guaranteed improvement of the applied change and the step size.
+fn certified_v_update(
+    setup: &Setup,
+    state: &mut State,
+    ev: &BlockEstimate,
+    required_v: f64,
+    v_new: &mut [f64],
+) -> Result<(BlockLog, f64, f64), RunError> {
+    let Setup { k, certify, .. } = *setup;
+    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
+        "the v-block returned no gradient".into(),
+    ))?;
+    let sigma_v = min_sigma(&state.w);
+    match setup.opts.v_direction {
+        VDirection::Greedy => {
+            let v_plan = steps::v_step(k, sigma_v, grad_v, required_v, certify)?;
+            let eps_v = eps_max(grad_v);
+            apply_realised(
+                v_new,
+                &v_plan,
+                |i| CoordinateBound::mean(k, sigma_v, grad_v.value[i], eps_v).map_err(bounds),
+                required_v,
+                certify,
+            )
+        }
+        VDirection::Adam {
+            lr,
+            beta1,
+            beta2,
+            eps,
+        } => {
+            let moments = state
+                .adam_v
+                .get_or_insert_with(|| AdamMoments::zeros(grad_v.value.len()));
+            let u = moments.step(&grad_v.value, lr, beta1, beta2, eps);
+            along_direction(setup, sigma_v, grad_v, &u, required_v, v_new)
+        }
+    }
+}
+
+/// The error of the bounds crate as a [`RunError`].
+fn bounds(e: sepg_bounds::BoundsError) -> RunError {
+    RunError::Bounds(e.to_string())
+}
+
+/// The w-step of the certified accounting for `required_w`, applied to `w_new` (a copy of
+/// wᵗ): from a w-block of `n_w` trajectories at (vᵗ⁺¹ = `v_new`, wᵗ), or from the v-block's
+/// batch `ev` for SIM-ν, realised and certified again against the rigorous w-bound. Returns
+/// Ĵ(vᵗ⁺¹, wᵗ) (`None` for SIM-ν), the block log and the guaranteed improvement.
+fn certified_w_update(
+    source: &mut dyn GradientSource,
+    setup: &Setup,
+    (state, sigmas, ev, v_new): (&State, &[f64], &BlockEstimate, &[f64]),
+    (required_w, alpha, n_w): (f64, f64, usize),
+    w_new: &mut [f64],
+    counts: (&mut u64, &mut u64),
+) -> Result<(Option<f64>, BlockLog, f64), RunError> {
+    let ew = if matches!(setup.req, Requirement::Sim { .. }) {
+        None
+    } else {
+        let q = (state.iteration, v_new, &state.w[..], n_w);
+        Some(w_block(source, setup.naive_w, q, counts)?)
+    };
+    let e_w = ew.as_ref().unwrap_or(ev);
+    let gj = e_w.grad_wj.as_ref().ok_or(RunError::Estimator(
+        "the w-block returned no w-gradient".into(),
+    ))?;
+    let plan = w_plan(setup, sigmas, e_w, required_w, alpha)?;
+    let k = setup.k;
+    let (log, g_w, _) = apply_realised(
+        w_new,
+        &plan,
+        |h| CoordinateBound::log_sigma(k, sigmas[h], gj.value[h], gj.eps[h]).map_err(bounds),
+        required_w,
+        setup.certify,
+    )?;
+    Ok((ew.map(|e| e.j), log, g_w))
 }
 
 /// Whether the variant evaluates a target policy θ_Tᵗ (LV, ZV, SIM-ν).
