@@ -6,8 +6,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use sepg_runs::figure::{BandKind, Style};
-use sepg_runs::report::{self, FigureOptions, Outputs, XAxis};
+use sepg_runs::figure_flags::FigureFlags;
+use sepg_runs::report::{self, Outputs};
 use sepg_runs::reproduce::{
     self, Experiment, LqgPreset, Mode, OptionFlags, ReproduceOptions, Setting,
 };
@@ -50,21 +50,9 @@ pub struct ReproduceArgs {
     /// Options overriding the setting's.
     #[command(flatten)]
     flags: OptionFlags,
-    /// Band around each curve of the figures: 95% interval, one standard error, or none
-    /// (warned about below 3 seeds) [default: ci95]. σ is banded on log σ, the budget by a
-    /// percentile bootstrap, so that no band leaves its quantity's domain.
-    #[arg(long, value_enum)]
-    band: Option<BandKind>,
-    /// Abscissa of the figures: iteration, trajectories or environment steps (trajectories ×
-    /// horizon) [default: trajectories for fig-5.3, iteration otherwise].
-    #[arg(long = "x-axis", value_enum)]
-    x_axis: Option<XAxis>,
-    /// Size of the figures' tick labels in points; other text scales with it (4 to 72).
-    #[arg(long = "font-size", allow_negative_numbers = true)]
-    font_size: Option<f64>,
-    /// Resolution of the figures in dots per inch (50 to 1200) [default: 100].
-    #[arg(long, allow_negative_numbers = true)]
-    dpi: Option<u32>,
+    /// Options of the figures.
+    #[command(flatten)]
+    figures: FigureFlags,
     /// Output folder [default: sepg-<experiment>].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -85,31 +73,8 @@ pub struct ReproduceArgs {
 /// Usage error (exit 2) for bad options or a non-empty output folder; failure (exit 1) for
 /// failed runs or I/O errors.
 pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
-    if args.what == Experiment::Table51
-        && let Some(flag) = [
-            (args.band.is_some(), "--band"),
-            (args.x_axis.is_some(), "--x-axis"),
-            (args.font_size.is_some(), "--font-size"),
-            (args.dpi.is_some(), "--dpi"),
-        ]
-        .iter()
-        .find_map(|&(given, flag)| given.then_some(flag))
-    {
-        return Err(CliError::usage(format!(
-            "{flag} applies to the figures; table-5.1 has none"
-        )));
-    }
-    let defaults = Style::default();
-    let figure_opts = FigureOptions {
-        band: args.band.unwrap_or_default(),
-        style: Style {
-            font_size: args.font_size.unwrap_or(defaults.font_size),
-            dpi: args.dpi.unwrap_or(defaults.dpi),
-        },
-        x_axis: args.x_axis,
-    };
     // Checked before any run starts, so that a bad style costs nothing.
-    figure_opts.style.validate()?;
+    let figure_opts = args.figures.options(args.what)?;
     let opts = ReproduceOptions {
         what: args.what,
         preset: args.preset,

@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use sepg_runs::folder::{self, RUN_FILES, Summary};
+use sepg_runs::folder::{self, Summary};
 use sepg_runs::run::{self, RunOptions};
+use sepg_runs::setup;
 use sepg_runs::spec::RunSpec;
 
 use crate::cli::CliError;
@@ -99,22 +100,13 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         }
         (dir.clone(), run::resume(dir, opts)?)
     } else {
-        let file = match &args.config {
-            Some(path) => RunSpec::from_file(path)?,
-            None => RunSpec::default(),
-        };
-        // A configuration copied from an earlier run is re-resolved by this version.
-        let merged = RunSpec {
-            sepg_version: None,
-            ..file.overlay(&args.spec)
-        };
-        let resolved = merged.resolve()?;
-        let dir = args
-            .out
-            .clone()
-            .ok_or_else(|| CliError::usage("--out DIR is required"))?;
-        folder::check_out_dir(&dir, args.force, &RUN_FILES)?;
-        (dir.clone(), run::start(&dir, &resolved, opts)?)
+        let new = setup::set_up(
+            args.config.as_deref(),
+            &args.spec,
+            args.out.as_deref(),
+            args.force,
+        )?;
+        (new.dir.clone(), new.start(opts)?)
     };
     if !args.quiet {
         println!("{}", summary_line(&dir, &summary));

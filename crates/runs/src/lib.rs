@@ -14,8 +14,11 @@
 //! spec, folder          options and their resolution; the files of a run folder
 //! ```
 //!
-//! [`estimate`] (streamed Monte Carlo estimates of one policy) and [`exact`] (exact values of
-//! an LQG preset) stand alone.
+//! [`estimate`] (streamed Monte Carlo estimates of one policy), [`exact`] (exact values of
+//! an LQG preset), [`replay`] (a Mountain Car trajectory) and [`bounds_report`] (the
+//! closed-form quantities of the bounds at given constants and gradients) stand alone.
+//! [`setup`] sets up a new run from a configuration file and options, for the command line
+//! and the Python package alike.
 //!
 //! [`audit`] sits beside them: it reads a run folder ([`folder`], [`spec`]) and re-checks its
 //! log against the exact oracles of `sepg-mdp`. Every fallible operation returns an
@@ -24,16 +27,20 @@
 #![deny(missing_docs)]
 
 pub mod audit;
+pub mod bounds_report;
 pub mod error;
 pub mod estimate;
 pub mod exact;
 pub mod figure;
+pub mod figure_flags;
 pub mod folder;
 pub mod logcheck;
 pub mod merge;
+pub mod replay;
 pub mod report;
 pub mod reproduce;
 pub mod run;
+pub mod setup;
 pub mod spec;
 pub mod sweep;
 
