@@ -1,11 +1,11 @@
 //! `sepg exact`: exact J and derivatives of a 1-D LQG preset — the closed form for the unclipped
 //! model (any horizon) or dynamic programming for the clipped model (finite horizon); the
-//! work and the checks of the arguments are `sepg_runs::exact`, this file parses and prints.
+//! work, the checks of the arguments and the report are `sepg_runs::exact` and
+//! `sepg_runs::exact_report`, this file parses and prints.
 
 use clap::Args;
-use sepg_mdp::oracle::{ExactEval, Horizon};
-use sepg_runs::exact::{ExactSpec, exact};
-use serde::Serialize;
+use sepg_runs::exact::ExactSpec;
+use sepg_runs::exact_report::exact_report;
 
 use crate::cli::CliError;
 use crate::commands::parse::{HorizonArg, LqgPreset};
@@ -39,65 +39,16 @@ pub struct ExactArgs {
     json: bool,
 }
 
-#[derive(Debug, Serialize)]
-struct ExactReport {
-    env: &'static str,
-    oracle: &'static str,
-    horizon: String,
-    v: f64,
-    sigma: f64,
-    eta: f64,
-    j: f64,
-    grad_v: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grad_w: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grad_sigma: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    mixed_wv: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    hessian: Option<Vec<Vec<f64>>>,
-}
-
-fn evaluate(args: &ExactArgs) -> Result<(ExactEval, Horizon), CliError> {
-    Ok(exact(&ExactSpec {
+/// Runs `sepg exact`.
+pub fn run(args: &ExactArgs) -> Result<(), CliError> {
+    let report = exact_report(&ExactSpec {
         env: args.env.name().to_string(),
         v: args.v,
         sigma: args.sigma,
         horizon: args.horizon.map(|h| h.0),
         eta: args.eta,
         clipped: args.clipped,
-    })?)
-}
-
-/// Runs `sepg exact`.
-pub fn run(args: &ExactArgs) -> Result<(), CliError> {
-    let (eval, horizon) = evaluate(args)?;
-    let report = ExactReport {
-        env: args.env.name(),
-        oracle: if args.clipped {
-            "clipped-dp"
-        } else {
-            "closed-form"
-        },
-        horizon: match horizon {
-            Horizon::Finite(h) => h.to_string(),
-            Horizon::Infinite => "inf".to_string(),
-        },
-        v: args.v,
-        sigma: args.sigma,
-        eta: args.eta,
-        j: eval.j,
-        grad_v: eval.grad_v[0],
-        grad_w: eval.grad_w.first().copied(),
-        grad_sigma: eval.grad_sigma().first().copied(),
-        mixed_wv: eval.mixed_wv.first().copied(),
-        hessian: eval.hessian.as_ref().map(|h| {
-            (0..h.nrows())
-                .map(|i| (0..h.ncols()).map(|j| h[(i, j)]).collect())
-                .collect()
-        }),
-    };
+    })?;
     if args.json {
         print!("{}", to_json_line(&report)?);
     } else {

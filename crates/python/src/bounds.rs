@@ -24,7 +24,11 @@ use sepg_certified::{
     RigorousEnclosure,
 };
 
-use crate::{PyTaskConstants, invalid, vector};
+use sepg_runs::bounds_report::{BoundsQuery, StepVerdict, report};
+use sepg_runs::spec::{ConstantsName, RewardsName};
+
+use crate::pyjson::serialize_to_py;
+use crate::{PyTaskConstants, horizon_arg, invalid, vector};
 
 type K<'a> = PyRef<'a, PyTaskConstants>;
 
@@ -823,7 +827,7 @@ impl PyInterval {
 }
 
 /// The outcome of a certified safe-step computation (docs/THEOREMS.md, "Certified steps"):
-/// `kind` is `"step"` (the bound at `chosen_step`, evaluated in interval arithmetic, is at
+/// `kind` is `"certified"` (the bound at `chosen_step`, evaluated in interval arithmetic, is at
 /// least C), `"infeasible"` (C > C_max; the vertex), `"uncertifiable"` (C ≤ C_max as
 /// computed, but no float step between the computed largest step and the vertex has an
 /// enclosure at least C: C is within rounding of C_max; the vertex), `"zero_gradient"` or
@@ -840,11 +844,12 @@ impl From<Certified> for PyCertified {
 
 #[pymethods]
 impl PyCertified {
-    /// `"step"`, `"infeasible"`, `"uncertifiable"`, `"zero_gradient"` or `"below_noise"`.
+    /// `"certified"`, `"infeasible"`, `"uncertifiable"`, `"zero_gradient"` or `"below_noise"`:
+    /// a certified step has the label of `sepg bounds --certified` and of [`bounds_report`].
     #[getter]
     fn kind(&self) -> &'static str {
         match self.0 {
-            Certified::Step(_) => "step",
+            Certified::Step(_) => StepVerdict::Certified.label(),
             Certified::Infeasible { .. } => "infeasible",
             Certified::Uncertifiable { .. } => "uncertifiable",
             Certified::ZeroGradient { .. } => "zero_gradient",
@@ -872,7 +877,7 @@ impl PyCertified {
     }
 
     /// How many ulps the certified step was moved from the computed largest step toward
-    /// the vertex (`kind == "step"` only).
+    /// the vertex (`kind == "certified"` only).
     #[getter]
     fn ulps_moved(&self) -> Option<u64> {
         match self.0 {
@@ -882,7 +887,7 @@ impl PyCertified {
     }
 
     /// Whether the certificate came from the a-priori rounding-error bound of the float
-    /// evaluation rather than from interval arithmetic (`kind == "step"` only).
+    /// evaluation rather than from interval arithmetic (`kind == "certified"` only).
     #[getter]
     fn by_error_bound(&self) -> Option<bool> {
         match self.0 {
@@ -892,7 +897,7 @@ impl PyCertified {
     }
 
     /// The safe interval as computed in floats, as a feasible `StepOutcome`
-    /// (`kind == "step"` only).
+    /// (`kind == "certified"` only).
     #[getter]
     fn interval(&self) -> Option<PyStepOutcome> {
         match self.0 {
@@ -1291,6 +1296,65 @@ impl PyExploringBound {
     }
 }
 
+/// A name of the command line's vocabulary (`constants`, `rewards`), raising
+/// `InvalidInputError` naming the argument and its choices otherwise.
+fn name_arg<T: serde::de::DeserializeOwned>(value: &str, arg: &str, choices: &str) -> PyResult<T> {
+    serde_json::from_value(serde_json::Value::String(value.to_owned()))
+        .map_err(|_| invalid(format!("{arg} = {value:?} must be {choices}")))
+}
+
+/// The report of `sepg bounds` as a dict, the object `sepg bounds --json` prints, built by the
+/// same library function: every closed-form quantity that the task constants (γ, R, M_φ,
+/// |A|), σ and the gradients determine (Theorems 3.11, 3.13, 3.14, 4.2, 4.3, 4.5, Lemma A.1,
+/// Corollary 4.4). The keywords are the command's flags: `grad_v` an array-like, `horizon` a
+/// positive integer or inf, `constants` "thesis" or "tight", `rewards` "two-sided" or
+/// "non-positive"; with `certified`, the key `certified` holds the outward-rounded enclosures
+/// and the certified largest steps, each with its `outcome` ("certified", "uncertifiable",
+/// "infeasible" or "no-step"). Quantities that the inputs do not determine are absent.
+#[pyfunction]
+#[pyo3(signature = (gamma, r_max, m_phi, action_volume, sigma, *, dim_v = None, grad_v = None,
+    grad_w = None, grad_w_l = None, required = 0.0, nu = None, delta = None, eps = None,
+    horizon = None, constants = "thesis", rewards = None, certified = false))]
+#[allow(clippy::too_many_arguments)]
+fn bounds_report<'py>(
+    py: Python<'py>,
+    gamma: f64,
+    r_max: f64,
+    m_phi: f64,
+    action_volume: f64,
+    sigma: f64,
+    dim_v: Option<usize>,
+    grad_v: Option<&Bound<'py, PyAny>>,
+    grad_w: Option<f64>,
+    grad_w_l: Option<f64>,
+    required: f64,
+    nu: Option<f64>,
+    delta: Option<f64>,
+    eps: Option<f64>,
+    horizon: Option<&Bound<'py, PyAny>>,
+    constants: &str,
+    rewards: Option<&str>,
+    certified: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let query = BoundsQuery {
+        dim_v,
+        grad_v: grad_v.map(|g| vector(g, "grad_v")).transpose()?,
+        grad_w,
+        grad_w_l,
+        required,
+        nu,
+        delta,
+        eps,
+        horizon: horizon.map(horizon_arg).transpose()?,
+        constants: name_arg::<ConstantsName>(constants, "constants", "\"thesis\" or \"tight\"")?,
+        rewards: rewards
+            .map(|r| name_arg::<RewardsName>(r, "rewards", "\"two-sided\" or \"non-positive\""))
+            .transpose()?,
+        ..BoundsQuery::new(gamma, r_max, m_phi, action_volume, sigma)
+    };
+    serialize_to_py(py, &report(&query, certified).map_err(invalid)?)
+}
+
 /// Adds the functions and classes of this module to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyStepOutcome>()?;
@@ -1306,5 +1370,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rigorous_k_mu, m)?)?;
     m.add_function(wrap_pyfunction!(certified_sqrt_2pi, m)?)?;
     m.add_function(wrap_pyfunction!(certified_psi, m)?)?;
+    m.add_function(wrap_pyfunction!(bounds_report, m)?)?;
     add_functions(m)
 }

@@ -142,6 +142,24 @@ pub(crate) fn vector(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
     Ok(values)
 }
 
+/// The horizon `h`: a positive integer, or `inf` as a float or the string "inf".
+pub(crate) fn horizon_arg(h: &Bound<'_, PyAny>) -> PyResult<Horizon> {
+    if let Ok(n) = h.extract::<i64>() {
+        match u64::try_from(n) {
+            Ok(n) if n >= 1 => Ok(Horizon::Finite(n)),
+            _ => Err(invalid(format!("horizon must be at least 1, got {n}"))),
+        }
+    } else if h.extract::<f64>().is_ok_and(|x| x == f64::INFINITY)
+        || h.extract::<String>().is_ok_and(|s| s == "inf")
+    {
+        Ok(Horizon::Infinite)
+    } else {
+        Err(invalid(format!(
+            "horizon must be a positive integer or inf, got {h}"
+        )))
+    }
+}
+
 /// The family of constants named by `constants` ("thesis" or "tight"), the tight family for
 /// `horizon` (a positive integer, or `inf` as a float or the string "inf") and `rewards`
 /// ("two-sided" or "non-positive").
@@ -163,20 +181,7 @@ fn family(
             let h = horizon.ok_or_else(|| {
                 invalid("constants=\"tight\" needs horizon (a positive integer or inf)")
             })?;
-            let horizon = if let Ok(n) = h.extract::<i64>() {
-                match u64::try_from(n) {
-                    Ok(n) if n >= 1 => Horizon::Finite(n),
-                    _ => return Err(invalid(format!("horizon must be at least 1, got {n}"))),
-                }
-            } else if h.extract::<f64>().is_ok_and(|x| x == f64::INFINITY)
-                || h.extract::<String>().is_ok_and(|s| s == "inf")
-            {
-                Horizon::Infinite
-            } else {
-                return Err(invalid(format!(
-                    "horizon must be a positive integer or inf, got {h}"
-                )));
-            };
+            let horizon = horizon_arg(h)?;
             let rewards = match rewards.unwrap_or("two-sided") {
                 "two-sided" => Rewards::TwoSided,
                 "non-positive" => Rewards::NonPositive,

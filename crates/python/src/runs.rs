@@ -12,8 +12,9 @@ use std::time::{Duration, Instant};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};
 use sepg_runs::Error;
-use sepg_runs::folder::{self, Log, RUN_FILES};
+use sepg_runs::folder::{self, Log};
 use sepg_runs::run::{self, RunObserver, RunOptions};
+use sepg_runs::setup;
 use sepg_runs::spec::RunSpec;
 use sepg_runs::sweep::{self, Shard, SweepOptions, SweepSpec};
 
@@ -101,28 +102,15 @@ fn run_folder<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let top: RunSpec = serde_json::from_value(from_py(options, "options")?)
         .map_err(|e| invalid(format!("{e}")))?;
-    let base = match &config {
-        Some(path) => RunSpec::from_file(path).map_err(invalid)?,
-        None => RunSpec::default(),
-    };
-    let spec = RunSpec {
-        sepg_version: None,
-        ..base.overlay(&top)
-    };
-    let resolved = spec.resolve().map_err(invalid)?;
-    folder::check_out_dir(&out, force, &RUN_FILES).map_err(invalid)?;
+    let new = setup::set_up(config.as_deref(), &top, Some(&out), force).map_err(invalid)?;
     let watch = SignalWatch::new();
     let every = checkpoint_period(checkpoint_every)?;
     let summary = py.detach(|| {
-        run::start(
-            &out,
-            &resolved,
-            RunOptions {
-                checkpoint_every: every,
-                stop: &watch.stop,
-                observer: &watch,
-            },
-        )
+        new.start(RunOptions {
+            checkpoint_every: every,
+            stop: &watch.stop,
+            observer: &watch,
+        })
     });
     serialize_to_py(py, &summary.map_err(|e| watch.error(e))?)
 }

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import sepg
-from sepg import bounds
+from sepg import _native, bounds
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 CLI = ROOT / "target" / "release" / "sepg"
@@ -141,7 +141,7 @@ def test_a_certified_v_step_meets_its_requirement_in_50_digit_arithmetic():
     cmax = bounds.v_update_c_max(K, sigma, grad)
     for required in (-0.01, 0.0, 0.5 * cmax, 0.999999 * cmax):
         o = bounds.certified_v_safe_step(K, sigma, grad, required)
-        assert o.kind == "step" and o.is_certified
+        assert o.kind == "certified" and o.is_certified
         exact = v_bound_decimal(K, sigma, grad, o.chosen_step)
         assert exact >= Decimal(required)
         assert Decimal(o.bound.lo) <= exact <= Decimal(o.bound.hi)
@@ -206,7 +206,7 @@ def test_an_enclosure_certifies_the_float_outcome_of_its_bound():
     # The direct wrapper may certify through the a-priori rounding-error bound, which moves a
     # failing step a few ulps further toward the vertex than the interval search does; both
     # steps must be certified by the same enclosure, and agree to within those ulps.
-    assert o.kind == direct.kind == "step"
+    assert o.kind == direct.kind == "certified"
     assert e.enclose(o.chosen_step).lo >= required
     assert e.enclose(direct.chosen_step).lo >= required
     assert abs(o.chosen_step - direct.chosen_step) <= 256 * math.ulp(o.chosen_step)
@@ -289,7 +289,7 @@ def test_the_quadratic_factories_hold_the_coefficients_of_theorems_4_2_to_4_5():
     # The same bound as the Enclosure of the same theorem, and it certifies the float step.
     assert ql.enclose(-0.1) == bounds.Enclosure.quadratic_w_along_l(K, sigma, j, l).enclose(-0.1)
     o = ql.enclosure().certify(bounds.w_update_safe_step_along_l(K, sigma, j, l, -0.01), -0.01)
-    assert o.kind == "step" and ql.enclose(o.chosen_step).lo >= -0.01
+    assert o.kind == "certified" and ql.enclose(o.chosen_step).lo >= -0.01
     assert q == bounds.Quadratic.v_update(K, sigma, gv) and q != qj
     with pytest.raises(sepg.InvalidInputError, match="non-negative"):
         bounds.Quadratic(0.3, bounds.Interval(-0.1, 0.7))
@@ -338,7 +338,7 @@ def test_the_certified_adaptive_step_encloses_the_theorem_3_10_bound():
     o = bounds.certified_adaptive_step(K, sigma, grad)
     alpha = Decimal(o.chosen_step)
     # The guarantee is an interval evaluation, not the a-priori error bound of the fast path.
-    assert o.kind == "step" and o.ulps_moved == 0 and o.by_error_bound is False
+    assert o.kind == "certified" and o.ulps_moved == 0 and o.by_error_bound is False
     assert abs(alpha - n2 / (2 * c * n1 * n1)) <= Decimal("1e-15") * alpha
     assert inside(o.bound, alpha * n2 - alpha * alpha * c * n1 * n1) and o.bound.lo > 0
     zero = bounds.certified_adaptive_step(K, sigma, [0.0, 0.0])
@@ -347,11 +347,11 @@ def test_the_certified_adaptive_step_encloses_the_theorem_3_10_bound():
     # evaluation; the same outcome certified through its enclosure is an interval search.
     lqg1d = sepg.TaskConstants(0.99, 28.8, 4.0, 8.0)
     fast = bounds.certified_v_safe_step(lqg1d, 0.5, [-3.7], 0.0)
-    assert fast.kind == "step" and fast.by_error_bound is True
+    assert fast.kind == "certified" and fast.by_error_bound is True
     searched = bounds.Quadratic.v_update(lqg1d, 0.5, [-3.7]).enclosure().certify(
         bounds.v_update_safe_step(lqg1d, 0.5, [-3.7], 0.0), 0.0
     )
-    assert searched.kind == "step" and searched.by_error_bound is False
+    assert searched.kind == "certified" and searched.by_error_bound is False
 
 
 def test_a_step_outcome_contains_its_safe_interval_only():
@@ -404,5 +404,41 @@ def test_the_certified_steps_are_those_of_the_command_line():
         ("beta_bar", bounds.certified_w_safe_step_along_l(k, sigma, gw, gl, req)),
     ):
         step = cli["steps"][name]
-        assert step["outcome"] == "certified" and ours.is_certified
+        assert step["outcome"] == ours.kind == "certified" and ours.is_certified
         assert step["step"] == ours.chosen_step and step["bound"] == [ours.bound.lo, ours.bound.hi]
+    # the Python report is the command line's object, built by the same library function
+    report = _native.bounds_report(0.9, 2.0, 1.5, 3.0, 0.7, grad_v=gv, grad_w=gw, grad_w_l=gl,
+                                   required=req, certified=True)
+    assert report == json.loads(out)
+
+
+def test_the_report_holds_the_closed_forms_and_labels_a_certified_step_as_its_certificate():
+    # Theorem 4.2 at gamma = 1/2, R = M_phi = |A| = sigma = 1: c = 4 (1/sqrt(2 pi) + 1/2).
+    r = _native.bounds_report(0.5, 1.0, 1.0, 1.0, 1.0, grad_v=[0.3, -0.8], grad_w=0.4, required=-0.01,
+                              certified=True)
+    c = 4.0 * (1.0 / math.sqrt(2.0 * math.pi) + 0.5)
+    assert r["c"] == pytest.approx(c, rel=1e-14)
+    assert r["alpha_star"] == pytest.approx(1.0 / (2.0 * c), rel=1e-15)
+    assert r["surrogate_coefficient"] == pytest.approx(1.0 / (4.0 * 2 * c), rel=1e-15)
+    k = sepg.TaskConstants(0.5, 1.0, 1.0, 1.0)
+    for name, ours in (
+        ("alpha_bar", bounds.certified_v_safe_step(k, 1.0, [0.3, -0.8], -0.01)),
+        ("beta_bar_j", bounds.certified_w_safe_step_along_j(k, 1.0, 0.4, -0.01)),
+    ):
+        assert r["certified"]["steps"][name]["outcome"] == ours.kind == "certified"
+    assert "beta_bar" not in r["certified"]["steps"]
+    tight = _native.bounds_report(0.9, 2.0, 1.5, 3.0, 0.7, constants="tight", horizon=20,
+                                  rewards="non-positive")
+    s_h = sum((t + 1) * 0.9**t for t in range(20))
+    assert (tight["rho"], tight["horizon"]) == (0.5, "20")
+    assert tight["s_h"] == pytest.approx(s_h, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [dict(grad_w_l=0.3), dict(constants="other"), dict(rewards="two-sided"), dict(constants="tight"),
+     dict(horizon=0, constants="tight"), dict(delta=0.2), dict(grad_v=[math.nan])],
+)
+def test_a_bad_report_query_raises_one_typed_value_error(kwargs):
+    with pytest.raises(sepg.InvalidInputError):
+        _native.bounds_report(0.9, 2.0, 1.5, 3.0, 0.7, **kwargs)

@@ -31,6 +31,7 @@ pub mod bounds_report;
 pub mod error;
 pub mod estimate;
 pub mod exact;
+pub mod exact_report;
 pub mod figure;
 pub mod figure_flags;
 pub mod folder;

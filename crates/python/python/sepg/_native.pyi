@@ -164,7 +164,7 @@ class Interval:
 
 class Certified:
     """A certified safe step (Theorems 4.2-4.9 evaluated in interval arithmetic): kind
-    "step", "infeasible", "uncertifiable", "zero_gradient" or "below_noise"."""
+    "certified", "infeasible", "uncertifiable", "zero_gradient" or "below_noise"."""
 
     @property
     def kind(self) -> str: ...
@@ -486,6 +486,26 @@ def certified_exploring_safe_step(
 ) -> Certified: ...
 def certified_adaptive_step(k: TaskConstants, sigma: float, grad: ArrayLike) -> Certified: ...
 def budget_split_requirement(required: float, nu: float) -> Tuple[float, float]: ...
+def bounds_report(
+    gamma: float,
+    r_max: float,
+    m_phi: float,
+    action_volume: float,
+    sigma: float,
+    *,
+    dim_v: Optional[int] = None,
+    grad_v: Optional[ArrayLike] = None,
+    grad_w: Optional[float] = None,
+    grad_w_l: Optional[float] = None,
+    required: float = 0.0,
+    nu: Optional[float] = None,
+    delta: Optional[float] = None,
+    eps: Optional[float] = None,
+    horizon: Optional[Union[int, float, str]] = None,
+    constants: str = "thesis",
+    rewards: Optional[str] = None,
+    certified: bool = False,
+) -> Dict[str, Any]: ...
 def run_folder(
     out: str,
     options: Dict[str, Any],
