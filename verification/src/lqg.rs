@@ -22,13 +22,7 @@ use sepg_mdp::rollout::rollout;
 pub(crate) const HORIZON: usize = 20;
 
 /// Which clipped LQG preset (docs/CONVENTIONS.md §1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Preset {
-    /// `lqg`: S, A = [−2, 2], reward −0.5(s² + a²).
-    Lqg,
-    /// `lqg1d`: S, A = [−4, 4], reward −0.9(s² + a²).
-    Lqg1d,
-}
+pub(crate) use sepg_mdp::env::LqgPreset as Preset;
 
 /// A clipped LQG preset at a discount factor γ, with its exact oracle and bound constants.
 pub(crate) struct Task {
@@ -51,10 +45,7 @@ impl Task {
     }
 
     fn build(preset: Preset, gamma: f64, clipping: bool) -> Option<Self> {
-        let base = match preset {
-            Preset::Lqg => LqgModel::thesis(),
-            Preset::Lqg1d => LqgModel::lqg1d(),
-        };
+        let base = preset.model();
         let model = base.with_gamma(gamma).ok()?.with_clipping(clipping);
         let oracle: Box<dyn ExactOracle> = if clipping {
             Box::new(ClippedDpOracle::new(&model).ok()?)

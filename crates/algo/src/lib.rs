@@ -21,8 +21,10 @@ pub mod core;
 pub mod solver;
 
 pub use core::config::{Algorithm, CheckedConfig, GradientMode, Requirement, SepgConfig};
+pub use core::defaults::*;
 pub use core::error::{ConfigError, RunError};
 pub use core::executor::{Collect, Executor, Observer, Solver};
+pub use core::names::{AlgoName, ConstantsName, RequirementName, UnknownName};
 pub use core::options::{
     Accounting, ConstantsFamily, Schedule, SepgOptions, VDirection, WDirection, WStep,
 };

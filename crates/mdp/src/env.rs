@@ -5,6 +5,7 @@
 //! caller-provided buffers (no allocation per step), computes its own policy features `φ(s)`,
 //! and publishes the constants the bounds of Chapters 3–4 need ([`EnvConstants`]).
 
+use std::fmt;
 use std::str::FromStr;
 
 use crate::features::FeatureError;
@@ -33,6 +34,9 @@ pub enum EnvError {
     /// No preset has this name.
     #[error("unknown environment preset {0:?} (known: lqg, lqg1d, mountain-car)")]
     UnknownPreset(String),
+    /// No LQG preset has this name.
+    #[error("unknown LQG preset '{0}' (expected lqg or lqg1d)")]
+    UnknownLqgPreset(String),
     /// The horizon is zero.
     #[error("the horizon must be at least 1")]
     ZeroHorizon,
@@ -380,14 +384,17 @@ fn quad_form(m: &[f64], d: usize, x: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// The named environment presets of docs/CONVENTIONS.md §1 (`lqg-nd` is built from a model with
-/// [`LqgEnv::new`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// [`LqgEnv::new`]), accepted by `--env`; serde and the command line (feature `clap`) use the
+/// registry names of [`Preset::name`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
 pub enum Preset {
-    /// `lqg`: thesis Sec 5.1 as written.
+    /// Thesis Sec 5.1 as written (S, A = [−2, 2], r = −0.5(s² + a²)).
     Lqg,
-    /// `lqg1d`: the 1-D LQG of the public code behind the thesis's numbers.
+    /// The 1-D LQG behind the thesis's numbers (S, A = [−4, 4], r = −0.9(s² + a²)).
     Lqg1d,
-    /// `mountain-car`: gymnasium `MountainCarContinuous-v0`, state+bias features.
+    /// Gymnasium's MountainCarContinuous-v0.
     MountainCar,
 }
 
@@ -422,6 +429,11 @@ impl Preset {
             .ok_or_else(|| EnvError::UnknownPreset(name.to_owned()))
     }
 
+    /// The LQG preset of this name, `None` for Mountain Car.
+    pub fn lqg(self) -> Option<LqgPreset> {
+        LqgPreset::ALL.into_iter().find(|p| p.preset() == self)
+    }
+
     /// Builds the preset environment.
     ///
     /// ```
@@ -429,11 +441,16 @@ impl Preset {
     /// assert_eq!(Preset::Lqg1d.build().constants().m_phi, 4.0);
     /// ```
     pub fn build(&self) -> AnyEnv {
-        match self {
-            Preset::Lqg => AnyEnv::Lqg(Box::new(LqgEnv::thesis())),
-            Preset::Lqg1d => AnyEnv::Lqg(Box::new(LqgEnv::lqg1d())),
-            Preset::MountainCar => AnyEnv::MountainCar(MountainCar::state_bias()),
+        match self.lqg() {
+            Some(lqg) => AnyEnv::Lqg(Box::new(lqg.build())),
+            None => AnyEnv::MountainCar(MountainCar::state_bias()),
         }
+    }
+}
+
+impl fmt::Display for Preset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -442,6 +459,80 @@ impl FromStr for Preset {
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         Preset::from_name(s)
+    }
+}
+
+/// The scalar LQG presets, the subset of [`Preset`] that has an LQG model (`lqg`, `lqg1d`),
+/// accepted by `--preset` and by `sepg exact --env`; their names are those of [`Preset`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum LqgPreset {
+    /// Thesis Sec 5.1 as written.
+    Lqg,
+    /// The 1-D LQG behind the thesis's numbers.
+    Lqg1d,
+}
+
+impl LqgPreset {
+    /// Both LQG presets, in registry order.
+    pub const ALL: [LqgPreset; 2] = [LqgPreset::Lqg, LqgPreset::Lqg1d];
+
+    /// The preset of the registry.
+    pub fn preset(self) -> Preset {
+        match self {
+            LqgPreset::Lqg => Preset::Lqg,
+            LqgPreset::Lqg1d => Preset::Lqg1d,
+        }
+    }
+
+    /// The registry name (`"lqg"`, `"lqg1d"`).
+    pub fn name(self) -> &'static str {
+        self.preset().name()
+    }
+
+    /// The preset's LQG model: S, A = [−2, 2] and reward −0.5(s² + a²) for `lqg`,
+    /// S, A = [−4, 4] and reward −0.9(s² + a²) for `lqg1d` (docs/CONVENTIONS.md §1).
+    pub fn model(self) -> LqgModel {
+        match self {
+            LqgPreset::Lqg => LqgModel::thesis(),
+            LqgPreset::Lqg1d => LqgModel::lqg1d(),
+        }
+    }
+
+    /// The preset's environment.
+    pub fn build(self) -> LqgEnv {
+        match self {
+            LqgPreset::Lqg => LqgEnv::thesis(),
+            LqgPreset::Lqg1d => LqgEnv::lqg1d(),
+        }
+    }
+}
+
+impl fmt::Display for LqgPreset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for LqgPreset {
+    type Err = EnvError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        LqgPreset::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| EnvError::UnknownLqgPreset(s.to_owned()))
+    }
+}
+
+/// A plain `#[arg]` of this type parses with [`FromStr`], whose message names the expected
+/// presets, rather than as a `ValueEnum` (which `#[arg(value_enum)]` still selects).
+#[cfg(feature = "clap")]
+impl clap::builder::ValueParserFactory for LqgPreset {
+    type Parser = fn(&str) -> Result<LqgPreset, EnvError>;
+
+    fn value_parser() -> Self::Parser {
+        LqgPreset::from_str
     }
 }
 
@@ -517,5 +608,41 @@ impl Environment for AnyEnv {
 
     fn as_mountain_car(&self) -> Option<&MountainCar> {
         dispatch!(self, e => e.as_mountain_car())
+    }
+}
+
+#[cfg(test)]
+mod preset_tests {
+    use super::*;
+
+    /// Every preset's name parses back to it, serde writes and reads the same name, and the
+    /// LQG presets are the presets with an LQG model, under the same names.
+    #[test]
+    fn preset_names_round_trip_and_the_lqg_presets_are_a_subset() {
+        for p in Preset::ALL {
+            assert_eq!(p.to_string().parse::<Preset>(), Ok(p));
+            let json = serde_json::to_string(&p).expect("json");
+            assert_eq!(json, format!("\"{p}\""));
+            assert_eq!(serde_json::from_str::<Preset>(&json).expect("parse"), p);
+            assert_eq!(
+                p.lqg().is_some(),
+                matches!(p.build(), AnyEnv::Lqg(_)),
+                "{p}"
+            );
+        }
+        for q in LqgPreset::ALL {
+            assert_eq!(q.to_string().parse::<LqgPreset>(), Ok(q));
+            assert_eq!(q.preset().lqg(), Some(q));
+            assert_eq!(q.name(), q.preset().name());
+            assert_eq!(AnyEnv::Lqg(Box::new(q.build())), q.preset().build());
+            assert_eq!(q.build().model(), &q.model());
+        }
+        assert_eq!(
+            "mountain-car"
+                .parse::<LqgPreset>()
+                .expect_err("not LQG")
+                .to_string(),
+            "unknown LQG preset 'mountain-car' (expected lqg or lqg1d)"
+        );
     }
 }

@@ -26,7 +26,7 @@ pub mod rollout;
 mod stream;
 
 pub use batch::{Batch, BatchError};
-pub use env::{AnyEnv, EnvConstants, EnvError, Environment, LqgEnv, Preset};
+pub use env::{AnyEnv, EnvConstants, EnvError, Environment, LqgEnv, LqgPreset, Preset};
 pub use lqg_model::{BoxBounds, LqgModel, ModelError};
 pub use mountain_car::MountainCar;
 pub use policy::{Exploration, GaussianPolicy, PolicyError};

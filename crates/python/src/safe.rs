@@ -253,7 +253,7 @@ type MeanAndWidths<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)
 /// Student-t half-widths ε_i = t(1 − δ/2, N − 1)·√(Var_i / N) (Sec 4.5, eq. 4.22), as two
 /// arrays of length d. Needs N ≥ 2.
 #[pyfunction]
-#[pyo3(signature = (samples, delta = 0.2))]
+#[pyo3(signature = (samples, delta = sepg_algo::DEFAULT_DELTA))]
 fn confidence_widths<'py>(
     py: Python<'py>,
     samples: &Bound<'py, PyAny>,
@@ -355,7 +355,7 @@ pub(crate) fn lengths_of(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<usize
 /// deviations that generated the actions. Returns a dict with `j`, `grad_v`, `eps_v`,
 /// `grad_w_j`, `eps_w_j`, `grad_w_l`, `eps_w_l`, `trajectories` and `steps`.
 #[pyfunction]
-#[pyo3(signature = (constants, sigma, rewards, score_v, score_w, lengths, delta = 0.2, grad_w_l = true))]
+#[pyo3(signature = (constants, sigma, rewards, score_v, score_w, lengths, delta = sepg_algo::DEFAULT_DELTA, grad_w_l = true))]
 #[allow(clippy::too_many_arguments)]
 fn estimate_block<'py>(
     py: Python<'py>,

@@ -9,9 +9,15 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};
 use sepg_algo::core::check::{OnContradiction, RawSteps};
-use sepg_algo::core::config::{Algorithm, Requirement};
+use sepg_algo::core::config::Algorithm;
+use sepg_algo::core::defaults::{
+    DEFAULT_ADAM_BETA1, DEFAULT_ADAM_BETA2, DEFAULT_ADAM_EPS, DEFAULT_ALGO, DEFAULT_BUDGET0,
+    DEFAULT_DELTA, DEFAULT_N_TRAJECTORIES, DEFAULT_NU, DEFAULT_QUANTILE_FACTOR,
+    DEFAULT_REQUIREMENT, DEFAULT_SEED, DEFAULT_SIGMA0, DEFAULT_V0, RUN_CONSTANTS,
+};
 use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::{Collect, Executor};
+use sepg_algo::core::names::{AlgoName, RequirementName};
 use sepg_algo::core::options::{Accounting, Confidence, Schedule, SepgOptions, VDirection};
 use sepg_algo::core::seed::Block;
 use sepg_algo::core::state::State;
@@ -25,9 +31,10 @@ use crate::record;
 use crate::safe::lengths_of;
 use crate::{PyTaskConstants, failed, floats, invalid, natural, real};
 
-/// The algorithm named as on the command line: `sepg-mi`, `sepg-lb1`, `sepg-lb2`, `sepg-lv`,
-/// `sepg-zv`, `sepg-sim`, `sepg-naive-w` (with `requirement`), `gpomdp-const` (with `alpha`,
-/// `beta`), `gpomdp-adam` (with `lr`, `lr_w`) or `adastep`; ν is the split of LB-I and SIM.
+/// The algorithm named as on the command line (a name of [`AlgoName`]): `sepg-mi`,
+/// `sepg-lb1`, `sepg-lb2`, `sepg-lv`, `sepg-zv`, `sepg-sim`, `sepg-naive-w` (with
+/// `requirement`, a name of [`RequirementName`]), `gpomdp-const` (with `alpha`, `beta`),
+/// `gpomdp-adam` (with `lr`, `lr_w`) or `adastep`; ν is the split of LB-I and SIM.
 pub(crate) fn algorithm(
     name: &str,
     nu: f64,
@@ -37,50 +44,31 @@ pub(crate) fn algorithm(
     lr: Option<f64>,
     lr_w: Option<f64>,
 ) -> PyResult<Algorithm> {
-    let req = |r: &str| -> PyResult<Requirement> {
-        Ok(match r {
-            "mi" => Requirement::Mi,
-            "lb1" => Requirement::LbI { nu },
-            "lb2" => Requirement::LbII,
-            "lv" => Requirement::Lv,
-            "zv" => Requirement::Zv,
-            "sim" => Requirement::Sim { nu },
-            other => {
-                return Err(invalid(format!(
-                    "unknown requirement {other:?}: expected mi, lb1, lb2, lv, zv or sim"
-                )));
-            }
-        })
-    };
+    let algo: AlgoName = name.parse().map_err(invalid)?;
     let need = |v: Option<f64>, what: &str| {
         v.ok_or_else(|| invalid(format!("algorithm {name} needs {what}")))
     };
-    Ok(match name {
-        "sepg-naive-w" => Algorithm::SepgNaiveW(req(requirement)?),
-        "gpomdp-const" => {
+    if let Some(r) = algo.sepg_requirement() {
+        return Ok(Algorithm::Sepg(r.requirement(Some(nu))));
+    }
+    Ok(match algo {
+        AlgoName::SepgNaiveW => {
+            let r: RequirementName = requirement.parse().map_err(invalid)?;
+            Algorithm::SepgNaiveW(r.requirement(Some(nu)))
+        }
+        AlgoName::GpomdpConst => {
             let a = need(alpha, "alpha")?;
             Algorithm::GpomdpConst {
                 alpha: a,
                 beta: beta.unwrap_or(a),
             }
         }
-        "gpomdp-adam" => {
+        AlgoName::GpomdpAdam => {
             let l = need(lr, "lr")?;
             Algorithm::adam(l, lr_w.unwrap_or(l))
         }
-        "adastep" => Algorithm::AdaStep,
-        other => match other.strip_prefix("sepg-") {
-            Some(r) if r != "naive-w" => Algorithm::Sepg(req(r).map_err(|_| {
-                invalid(format!(
-                    "unknown algorithm {other:?}: expected sepg-mi, sepg-lb1, sepg-lb2, sepg-lv, sepg-zv, sepg-sim, sepg-naive-w, gpomdp-const, gpomdp-adam or adastep"
-                ))
-            })?),
-            _ => {
-                return Err(invalid(format!(
-                    "unknown algorithm {other:?}: expected sepg-mi, sepg-lb1, sepg-lb2, sepg-lv, sepg-zv, sepg-sim, sepg-naive-w, gpomdp-const, gpomdp-adam or adastep"
-                )));
-            }
-        },
+        // adastep (the SEPG variants named by their requirement returned above)
+        _ => Algorithm::AdaStep,
     })
 }
 
@@ -107,9 +95,9 @@ fn v_direction(
             let lr = lr.ok_or_else(|| invalid("v_direction=\"adam\" needs adam_lr"))?;
             Ok(VDirection::Adam {
                 lr,
-                beta1: beta1.unwrap_or(0.9),
-                beta2: beta2.unwrap_or(0.999),
-                eps: eps.unwrap_or(1e-8),
+                beta1: beta1.unwrap_or(DEFAULT_ADAM_BETA1),
+                beta2: beta2.unwrap_or(DEFAULT_ADAM_BETA2),
+                eps: eps.unwrap_or(DEFAULT_ADAM_EPS),
             })
         }
         other => Err(invalid(format!(
@@ -183,13 +171,10 @@ struct PyCollector {
 }
 
 impl PyCollector {
-    fn collect_py(
-        &self,
-        py: Python<'_>,
-        r: &BatchRequest<'_>,
-    ) -> PyResult<(Batch, Option<RawSteps>)> {
+    /// The request handed to the Python collector for the batch `r`.
+    fn request(&self, r: &BatchRequest<'_>) -> PyBatchRequest {
         let seeds = |stream| (0..r.n as u64).map(move |i| r.key.trajectory_seed(i, stream));
-        let request = PyBatchRequest {
+        PyBatchRequest {
             iteration: r.iteration,
             block: match r.block {
                 Block::V => "v",
@@ -205,8 +190,15 @@ impl PyCollector {
             v: r.v.to_vec(),
             w: r.w.map(<[f64]>::to_vec),
             actions: r.v.len() / self.features,
-        };
-        let out = self.callable.bind(py).call1((request,))?;
+        }
+    }
+
+    fn collect_py(
+        &self,
+        py: Python<'_>,
+        r: &BatchRequest<'_>,
+    ) -> PyResult<(Batch, Option<RawSteps>)> {
+        let out = self.callable.bind(py).call1((self.request(r),))?;
         let parts: (
             Bound<'_, PyAny>,
             Bound<'_, PyAny>,
@@ -244,6 +236,20 @@ impl PyCollector {
             };
             return Ok((batch, Some(raw)));
         };
+        self.scored_batch(r, w, (rw, h, lens), (phi, fshape), (a, ashape))
+    }
+
+    /// The batch of `r` with its policy scores, from the rewards `(values, H, lengths)`, the
+    /// features and the actions the collector returned (flat values and shapes).
+    fn scored_batch(
+        &self,
+        r: &BatchRequest<'_>,
+        w: &[f64],
+        (rw, h, lens): (Vec<f64>, usize, Vec<usize>),
+        (phi, fshape): (Vec<f64>, Vec<usize>),
+        (a, ashape): (Vec<f64>, Vec<usize>),
+    ) -> PyResult<(Batch, Option<RawSteps>)> {
+        let n = r.n;
         let policy =
             GaussianPolicy::new(r.v.to_vec(), w.to_vec(), self.features).map_err(invalid)?;
         let (l, p) = (policy.action_dim(), self.features);
@@ -332,7 +338,7 @@ impl Trainer {
     /// raises at the first value beyond its bound, "continue" goes on and records the
     /// contradiction in the state's `constants_check` (no guarantee).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = "zv", alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = "stop", **unknown))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = DEFAULT_REQUIREMENT.name(), alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = "stop", **unknown))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -369,40 +375,14 @@ impl Trainer {
         }
         // numbers are read here rather than by pyo3, so that a wrong type names the argument
         let n_trajectories: usize =
-            n_trajectories.map_or(Ok(100), |n| natural(n, "n_trajectories"))?;
-        let seed: u64 = seed.map_or(Ok(0), |s| natural(s, "seed"))?;
-        let delta = delta.map_or(Ok(0.2), |d| real(d, "delta"))?;
-        let nu = nu.map_or(Ok(0.5), |x| real(x, "nu"))?;
-        let initial_budget = initial_budget.map_or(Ok(0.0), |b| real(b, "initial_budget"))?;
+            n_trajectories.map_or(Ok(DEFAULT_N_TRAJECTORIES), |n| natural(n, "n_trajectories"))?;
+        let seed: u64 = seed.map_or(Ok(DEFAULT_SEED), |s| natural(s, "seed"))?;
+        let delta = delta.map_or(Ok(DEFAULT_DELTA), |d| real(d, "delta"))?;
+        let nu = nu.map_or(Ok(DEFAULT_NU), |x| real(x, "nu"))?;
+        let initial_budget =
+            initial_budget.map_or(Ok(DEFAULT_BUDGET0), |b| real(b, "initial_budget"))?;
         let algorithm = self::algorithm(algorithm, nu, requirement, alpha, beta, lr, lr_w)?;
-        let dim_v = actions
-            .checked_mul(features)
-            .ok_or_else(|| invalid("actions × features overflows"))?;
-        let v0 = match v0 {
-            Some(v) => floats(v, "v0", None)?.0,
-            None => vec![-0.1; dim_v],
-        };
-        let sigma0 = match sigma0 {
-            Some(s) => floats(s, "sigma0", None)?.0,
-            None => vec![1.0; actions],
-        };
-        if v0.len() != dim_v || sigma0.len() != actions {
-            return Err(invalid(format!(
-                "v0 must have {dim_v} entries (actions × features) and sigma0 {actions}; got {} and {}",
-                v0.len(),
-                sigma0.len()
-            )));
-        }
-        if let Some(s) = sigma0.iter().find(|s| !(**s > 0.0 && s.ln().is_finite())) {
-            return Err(invalid(format!(
-                "sigma0 must be positive and finite, got {s}"
-            )));
-        }
-        if !(initial_budget.is_finite() && initial_budget >= 0.0) {
-            return Err(invalid(format!(
-                "initial_budget = {initial_budget} must be finite and non-negative"
-            )));
-        }
+        let state = initial_state(actions, features, v0, sigma0, initial_budget)?;
         let config = CollectedConfig {
             algorithm,
             constants: constants.0,
@@ -420,40 +400,16 @@ impl Trainer {
             features,
             error: Arc::clone(&error),
         };
-        // the trainer knows no iteration count, so δ is not spread over a run: every width is
-        // at level δ, Student-t (docs/THEOREMS.md, "Statements over a whole run")
-        let mut options = SepgOptions {
-            schedule: Schedule::Iteration,
-            confidence: Confidence::StudentT { factor: 1.0 },
-            ..SepgOptions::default()
-        };
-        if let Some(n0) = reference_batch {
-            options.reference_batch = n0;
-        }
-        options.accounting = match accounting {
-            "certified" => Accounting::Certified,
-            "estimated" => Accounting::Estimated,
-            other => {
-                return Err(invalid(format!(
-                    "accounting = {other:?} must be \"certified\" or \"estimated\""
-                )));
-            }
-        };
-        options.v_direction =
-            self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
-        options.on_contradiction = match on_contradiction {
-            "stop" => OnContradiction::Stop,
-            "continue" => OnContradiction::Continue,
-            other => {
-                return Err(invalid(format!(
-                    "on_contradiction = {other:?} must be \"stop\" or \"continue\""
-                )));
-            }
-        };
+        let options = trainer_options(
+            reference_batch,
+            accounting,
+            v_direction,
+            (adam_lr, adam_beta1, adam_beta2, adam_eps),
+            on_contradiction,
+        )?;
         let solver = PolicySolver::with_collector(&config, Box::new(collector))
             .and_then(|s| s.with_options(options))
             .map_err(invalid)?;
-        let state = State::new(v0, sigma0.iter().map(|s| s.ln()).collect(), initial_budget);
         Ok(Trainer {
             parts: Some((solver, state)),
             error,
@@ -513,9 +469,131 @@ impl Trainer {
     }
 }
 
+/// The initial state of a [`Trainer`]: v⁰ (default [`DEFAULT_V0`] everywhere, `actions ×
+/// features` entries), σ⁰ (default [`DEFAULT_SIGMA0`], `actions` entries, positive with a
+/// finite logarithm) and the budget B⁰ (finite, non-negative).
+fn initial_state(
+    actions: usize,
+    features: usize,
+    v0: Option<&Bound<'_, PyAny>>,
+    sigma0: Option<&Bound<'_, PyAny>>,
+    initial_budget: f64,
+) -> PyResult<State> {
+    let dim_v = actions
+        .checked_mul(features)
+        .ok_or_else(|| invalid("actions × features overflows"))?;
+    let v0 = match v0 {
+        Some(v) => floats(v, "v0", None)?.0,
+        None => vec![DEFAULT_V0; dim_v],
+    };
+    let sigma0 = match sigma0 {
+        Some(s) => floats(s, "sigma0", None)?.0,
+        None => vec![DEFAULT_SIGMA0; actions],
+    };
+    if v0.len() != dim_v || sigma0.len() != actions {
+        return Err(invalid(format!(
+            "v0 must have {dim_v} entries (actions × features) and sigma0 {actions}; got {} and {}",
+            v0.len(),
+            sigma0.len()
+        )));
+    }
+    if let Some(s) = sigma0.iter().find(|s| !(**s > 0.0 && s.ln().is_finite())) {
+        return Err(invalid(format!(
+            "sigma0 must be positive and finite, got {s}"
+        )));
+    }
+    if !(initial_budget.is_finite() && initial_budget >= 0.0) {
+        return Err(invalid(format!(
+            "initial_budget = {initial_budget} must be finite and non-negative"
+        )));
+    }
+    Ok(State::new(
+        v0,
+        sigma0.iter().map(|s| s.ln()).collect(),
+        initial_budget,
+    ))
+}
+
+/// The SEPG options of a [`Trainer`]: Student-t widths at level δ each, the reference batch,
+/// the accounting, the v-direction with Adam's (lr, β₁, β₂, ε) and the reaction to a
+/// contradiction, each named as in [`Trainer`]'s constructor.
+fn trainer_options(
+    reference_batch: Option<usize>,
+    accounting: &str,
+    v_direction: &str,
+    adam: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
+    on_contradiction: &str,
+) -> PyResult<SepgOptions> {
+    // the trainer knows no iteration count, so δ is not spread over a run: every width is
+    // at level δ, Student-t (docs/THEOREMS.md, "Statements over a whole run")
+    let mut options = SepgOptions {
+        schedule: Schedule::Iteration,
+        confidence: Confidence::StudentT {
+            factor: DEFAULT_QUANTILE_FACTOR,
+        },
+        ..SepgOptions::default()
+    };
+    if let Some(n0) = reference_batch {
+        options.reference_batch = n0;
+    }
+    options.accounting = match accounting {
+        "certified" => Accounting::Certified,
+        "estimated" => Accounting::Estimated,
+        other => {
+            return Err(invalid(format!(
+                "accounting = {other:?} must be \"certified\" or \"estimated\""
+            )));
+        }
+    };
+    let (adam_lr, adam_beta1, adam_beta2, adam_eps) = adam;
+    options.v_direction =
+        self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
+    options.on_contradiction = match on_contradiction {
+        "stop" => OnContradiction::Stop,
+        "continue" => OnContradiction::Continue,
+        other => {
+            return Err(invalid(format!(
+                "on_contradiction = {other:?} must be \"stop\" or \"continue\""
+            )));
+        }
+    };
+    Ok(options)
+}
+
+/// The required improvements `(C_v, C_w)` of SEPG's v- and w-updates for the requirement
+/// named `requirement` (Table 4.1; [`Requirement::required_improvements`]), the budget B,
+/// the split ν and, for LB-I, the drop J(θ⁰) − J(θᵗ); read by `sepg.required_improvement`,
+/// which checks the arguments' types first.
+///
+/// [`Requirement::required_improvements`]: sepg_algo::Requirement::required_improvements
+#[pyfunction]
+fn _required_improvement(
+    requirement: &str,
+    budget: f64,
+    nu: f64,
+    j_drop: f64,
+) -> PyResult<(f64, f64)> {
+    let r: RequirementName = requirement.parse().map_err(invalid)?;
+    r.requirement(Some(nu))
+        .required_improvements(budget, j_drop)
+        .map_err(invalid)
+}
+
 /// Adds the classes of this module to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBatchRequest>()?;
     m.add_class::<Trainer>()?;
+    m.add_function(wrap_pyfunction!(_required_improvement, m)?)?;
+    // the names and defaults the Python package reads (one table, in sepg_algo)
+    m.add("_ALGORITHMS", AlgoName::names())?;
+    m.add("_REQUIREMENTS", RequirementName::names())?;
+    m.add("_DEFAULT_ALGORITHM", DEFAULT_ALGO.name())?;
+    m.add("_DEFAULT_REQUIREMENT", DEFAULT_REQUIREMENT.name())?;
+    m.add("_DEFAULT_CONSTANTS", RUN_CONSTANTS.name())?;
+    m.add("_DEFAULT_DELTA", DEFAULT_DELTA)?;
+    m.add("_DEFAULT_NU", DEFAULT_NU)?;
+    m.add("_DEFAULT_N_TRAJECTORIES", DEFAULT_N_TRAJECTORIES)?;
+    m.add("_DEFAULT_SEED", DEFAULT_SEED)?;
+    m.add("_DEFAULT_BUDGET0", DEFAULT_BUDGET0)?;
     Ok(())
 }

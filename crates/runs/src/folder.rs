@@ -115,39 +115,51 @@ fn indexed(name: &str, dim: usize) -> Vec<String> {
 /// when it was not — infeasible or within rounding of C_max —, empty when certification is
 /// off or no step was taken; see `sepg_algo::core::record::Record::certified_v`).
 pub fn log_header(dim_v: usize, dim_w: usize) -> String {
-    let mut cols = vec!["iteration".to_owned()];
-    cols.extend(indexed("v", dim_v));
-    cols.extend(indexed("w", dim_w));
-    cols.extend(indexed("sigma", dim_w));
-    cols.extend(["j_explore", "j_after_v", "j_target"].map(String::from));
-    cols.extend(indexed("w_target", dim_w));
-    cols.extend(
-        [
-            "budget",
-            "required",
-            "required_w",
-            "alpha",
-            "beta",
-            "lambda_v",
-            "lambda_w",
-            "guaranteed_v",
-            "guaranteed_w",
-            "infeasible",
-            "infeasible_v",
-            "infeasible_w",
-            "below_noise_v",
-            "below_noise_w",
-            "trajectories",
-            "steps",
-            "certified_v",
-            "certified_w",
-        ]
-        .map(String::from),
-    );
+    let mut cols = Vec::new();
+    for c in LOG_COLUMNS {
+        cols.extend(match c {
+            "v" => indexed(c, dim_v),
+            "w" | "sigma" | "w_target" => indexed(c, dim_w),
+            _ => vec![c.to_owned()],
+        });
+    }
     let mut s = cols.join(",");
     s.push('\n');
     s
 }
+
+/// The columns of `log.csv` in the file's order, the names of every face (the records of
+/// the Python trainer are dicts with these keys): `v` has one column per mean parameter,
+/// `w`, `sigma` and `w_target` one per standard deviation (`v_0, v_1, …`, or the name alone
+/// for one component); see [`log_header`].
+pub const LOG_COLUMNS: [&str; 26] = [
+    "iteration",
+    "v",
+    "w",
+    "sigma",
+    "j_explore",
+    "j_after_v",
+    "j_target",
+    "w_target",
+    "budget",
+    "required",
+    "required_w",
+    "alpha",
+    "beta",
+    "lambda_v",
+    "lambda_w",
+    "guaranteed_v",
+    "guaranteed_w",
+    "infeasible",
+    "infeasible_v",
+    "infeasible_w",
+    "below_noise_v",
+    "below_noise_w",
+    "trajectories",
+    "steps",
+    "certified_v",
+    "certified_w",
+];
 
 fn num(x: f64) -> String {
     format!("{x:?}")

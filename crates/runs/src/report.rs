@@ -520,19 +520,7 @@ fn with_zero_line(mut p: Panel) -> Panel {
 /// G(PO)MDP-Adam); names it does not know are kept as they are.
 pub fn display_name(variant: &str) -> String {
     let short = variant.strip_prefix("sepg-").unwrap_or(variant);
-    let known = match short {
-        "mi" => Some("SEPG-MI"),
-        "lb1" => Some("SEPG-LB-I"),
-        "lb2" => Some("SEPG-LB-II"),
-        "lv" => Some("SEPG-LV"),
-        "zv" => Some("SEPG-ZV"),
-        "sim" => Some("SEPG-SIM"),
-        "naive-w" => Some("SEPG naive w"),
-        "gpomdp-adam" => Some("G(PO)MDP-Adam"),
-        "gpomdp-const" => Some("G(PO)MDP"),
-        "adastep" => Some("adaptive step (fixed σ)"),
-        _ => None,
-    };
+    let known = sepg_algo::AlgoName::from_short_name(short).map(sepg_algo::AlgoName::thesis_name);
     if let Some(k) = known {
         return k.to_owned();
     }

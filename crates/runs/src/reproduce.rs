@@ -70,15 +70,8 @@ impl Experiment {
     }
 }
 
-/// LQG presets accepted by `--preset`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "clap", derive(ValueEnum))]
-pub enum LqgPreset {
-    /// Thesis Sec 5.1 as written.
-    Lqg,
-    /// The 1-D LQG behind the thesis's numbers.
-    Lqg1d,
-}
+/// LQG presets accepted by `--preset` (the LQG presets of `sepg-mdp`).
+pub use sepg_mdp::env::LqgPreset;
 
 /// A named choice of the algorithm options for a whole reproduction. The options each
 /// setting fixes are listed in docs/REPRODUCTION.md; flags override them one by one.
@@ -324,7 +317,7 @@ impl ReproduceOptions {
             preset: None,
             seeds: 10,
             iterations: None,
-            delta: 0.2,
+            delta: sepg_algo::DEFAULT_DELTA,
             fig_sigma0: 1.0,
             setting: Setting::Default,
             flags: OptionFlags::default(),
@@ -382,9 +375,8 @@ fn presets(opts: &ReproduceOptions) -> Result<Vec<EnvName>> {
             ));
         }
         (Experiment::Fig54, None) => vec![EnvName::MountainCar],
-        (_, Some(LqgPreset::Lqg)) => vec![EnvName::Lqg],
-        (_, Some(LqgPreset::Lqg1d)) => vec![EnvName::Lqg1d],
-        (_, None) => vec![EnvName::Lqg, EnvName::Lqg1d],
+        (_, Some(preset)) => vec![preset.preset()],
+        (_, None) => LqgPreset::ALL.map(LqgPreset::preset).to_vec(),
     })
 }
 

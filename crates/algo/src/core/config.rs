@@ -1,5 +1,10 @@
 //! Run configuration: unchecked [`SepgConfig`] → validated [`CheckedConfig`] (linfa's
 //! `ParamGuard` pattern). Only a checked configuration can build a solver.
+use crate::core::defaults::{
+    DEFAULT_ADAM_BETA1, DEFAULT_ADAM_BETA2, DEFAULT_ADAM_EPS, DEFAULT_BUDGET0, DEFAULT_DELTA,
+    DEFAULT_ITERATIONS, DEFAULT_N_TRAJECTORIES, DEFAULT_SEED, DEFAULT_SIGMA0, DEFAULT_V0,
+};
+use sepg_bounds::budget::split_requirement;
 use sepg_bounds::constants::TaskConstants;
 use sepg_estimators::GradientSpec;
 use sepg_mdp::env::{AnyEnv, Environment};
@@ -43,6 +48,39 @@ pub enum Requirement {
 }
 
 impl Requirement {
+    /// The required improvements `(C_v, C_w)` of the v- and w-updates under the estimated
+    /// bookkeeping (Table 4.1, Sec 4.4.4), for the budget B = `budget` and, for LB-I, the
+    /// drop `j_drop` = J(θ⁰) − J(θᵗ) (units of J): MI (0, 0); LB-I ((1 − ν)C, νC) with
+    /// C = `j_drop` (eqs. 4.13, 4.14); LB-II, LV and ZV (−B, −B) (Definition 4.3); SIM-ν
+    /// (−νB, −(1 − ν)B). Between the two updates SEPG updates B: the w-update's value is this
+    /// function's at the new budget.
+    ///
+    /// # Errors
+    /// [`BoundsError`](sepg_bounds::BoundsError) for a non-finite `j_drop` (LB-I) or
+    /// `budget` (SIM-ν), or ν ∉ [0, 1] (LB-I, SIM-ν).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::Requirement;
+    /// assert_eq!(Requirement::Sim { nu: 0.25 }.required_improvements(4.0, 0.0), Ok((-1.0, -3.0)));
+    /// assert_eq!(Requirement::LbI { nu: 0.25 }.required_improvements(4.0, 2.0), Ok((1.5, 0.5)));
+    /// ```
+    pub fn required_improvements(
+        self,
+        budget: f64,
+        j_drop: f64,
+    ) -> Result<(f64, f64), sepg_bounds::BoundsError> {
+        match self {
+            Requirement::Mi => split_requirement(0.0, 0.0),
+            Requirement::LbI { nu } => split_requirement(j_drop, nu),
+            Requirement::Sim { nu } => {
+                let (v, w) = split_requirement(-budget, nu)?;
+                Ok((w, v))
+            }
+            Requirement::LbII | Requirement::Lv | Requirement::Zv => Ok((-budget, -budget)),
+        }
+    }
+
     /// Whether the requirement uses the budget B (type II, including SIM-ν).
     ///
     /// # Examples
@@ -125,9 +163,9 @@ impl Algorithm {
         Algorithm::GpomdpAdam {
             lr_v,
             lr_w,
-            beta1: 0.9,
-            beta2: 0.999,
-            epsilon: 1e-8,
+            beta1: DEFAULT_ADAM_BETA1,
+            beta2: DEFAULT_ADAM_BETA2,
+            epsilon: DEFAULT_ADAM_EPS,
         }
     }
 
@@ -262,15 +300,17 @@ impl SepgConfig {
         SepgConfig {
             env,
             algorithm,
-            gradient: GradientMode::Sampled { delta: 0.2 },
+            gradient: GradientMode::Sampled {
+                delta: DEFAULT_DELTA,
+            },
             estimator: GradientSpec::default(),
-            v0: vec![-0.1; dim_v],
-            sigma0: vec![1.0; dim_w],
-            n_trajectories: 100,
+            v0: vec![DEFAULT_V0; dim_v],
+            sigma0: vec![DEFAULT_SIGMA0; dim_w],
+            n_trajectories: DEFAULT_N_TRAJECTORIES,
             horizon: 20,
-            iterations: 10_000,
-            seed: 0,
-            initial_budget: 0.0,
+            iterations: DEFAULT_ITERATIONS,
+            seed: DEFAULT_SEED,
+            initial_budget: DEFAULT_BUDGET0,
             options: SepgOptions::default(),
             score_action: ScoreAction::Raw,
         }

@@ -2,8 +2,10 @@
 pub mod adam;
 pub mod check;
 pub mod config;
+pub mod defaults;
 pub mod error;
 pub mod executor;
+pub mod names;
 pub mod options;
 pub mod record;
 pub mod seed;

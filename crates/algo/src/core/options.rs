@@ -22,6 +22,10 @@
 //! as well.
 
 use crate::core::check::OnContradiction;
+use crate::core::defaults::{
+    DEFAULT_ADAM_BETA1, DEFAULT_ADAM_BETA2, DEFAULT_ADAM_EPS, DEFAULT_QUANTILE_FACTOR,
+    DEFAULT_REFERENCE_BATCH, LIBRARY_CONSTANTS,
+};
 use sepg_bounds::penalties::{Family, Horizon, Rewards, Tight};
 use serde::{Deserialize, Serialize};
 
@@ -185,9 +189,9 @@ impl VDirection {
     pub fn adam(lr: f64) -> Self {
         VDirection::Adam {
             lr,
-            beta1: 0.9,
-            beta2: 0.999,
-            eps: 1e-8,
+            beta1: DEFAULT_ADAM_BETA1,
+            beta2: DEFAULT_ADAM_BETA2,
+            eps: DEFAULT_ADAM_EPS,
         }
     }
 
@@ -369,12 +373,13 @@ impl Default for SepgOptions {
             confidence: Confidence::default(),
             lb1_requirement: Lb1Requirement::Split,
             alternating: false,
-            reference_batch: 1000,
+            reference_batch: DEFAULT_REFERENCE_BATCH,
             overrides: ConstantOverrides::default(),
             accounting: Accounting::Certified,
             schedule: Schedule::Run,
             v_direction: VDirection::Greedy,
-            constants: ConstantsFamily::Thesis,
+            // The reward sign is read by the tight family only: two-sided is always sound.
+            constants: LIBRARY_CONSTANTS.family(RewardSign::TwoSided),
             on_contradiction: OnContradiction::Stop,
         }
     }
@@ -395,7 +400,9 @@ impl SepgOptions {
         SepgOptions {
             accounting: Accounting::Estimated,
             schedule: Schedule::Iteration,
-            confidence: Confidence::StudentT { factor: 1.0 },
+            confidence: Confidence::StudentT {
+                factor: DEFAULT_QUANTILE_FACTOR,
+            },
             ..SepgOptions::default()
         }
     }

@@ -644,7 +644,7 @@ mod tests {
                 let external = CollectedConfig {
                     algorithm,
                     constants: *checked.constants(),
-                    delta: 0.2,
+                    delta: crate::core::defaults::DEFAULT_DELTA,
                     estimator: cfg.estimator,
                     n_trajectories: cfg.n_trajectories,
                     seed: cfg.seed,

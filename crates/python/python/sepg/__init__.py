@@ -29,6 +29,8 @@ if TYPE_CHECKING:
 from sepg import bounds, errors, runs
 from sepg._native import __version__
 from sepg._native import (
+    _REQUIREMENTS,
+    _required_improvement,
     mountain_car_trajectory,
     BatchRequest,
     Budget,
@@ -45,8 +47,6 @@ from sepg._native import (
     w_step,
 )
 from sepg.errors import InvalidInputError, MissingConstantError, RunFailedError, SepgError
-
-_REQUIREMENTS = ("mi", "lb1", "lb2", "lv", "zv", "sim")
 
 
 def required_improvement(
@@ -79,16 +79,12 @@ def required_improvement(
             raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
     if not math.isfinite(budget) or budget < 0.0:
         raise InvalidInputError(f"budget = {budget} must be finite and non-negative")
-    if requirement == "mi":
-        return bounds.budget_split_requirement(0.0, 0.0)
+    j_drop = 0.0
     if requirement == "lb1":
         if j_initial is None or j_current is None:
             raise InvalidInputError("requirement lb1 needs j_initial and j_current")
-        return bounds.budget_split_requirement(j_initial - j_current, nu)
-    if requirement == "sim":
-        v, w = bounds.budget_split_requirement(-budget, nu)
-        return w, v
-    return -budget, -budget
+        j_drop = j_initial - j_current
+    return _required_improvement(requirement, budget, nu, j_drop)
 
 
 def records_to_arrays(records: Sequence[Dict[str, Any]]) -> Dict[str, Any]:

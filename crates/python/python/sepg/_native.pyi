@@ -11,6 +11,19 @@ Adaptive = Tuple[Optional[float], Optional[float], str]
 
 __version__: str
 
+# The names and defaults of the Rust crates, read by the package (sepg_algo's one table).
+_ALGORITHMS: Tuple[str, ...]
+_REQUIREMENTS: Tuple[str, ...]
+_DEFAULT_ALGORITHM: str
+_DEFAULT_REQUIREMENT: str
+_DEFAULT_CONSTANTS: str
+_DEFAULT_DELTA: float
+_DEFAULT_NU: float
+_DEFAULT_N_TRAJECTORIES: int
+_DEFAULT_SEED: int
+_DEFAULT_BUDGET0: float
+_required_improvement: Callable[[str, float, float, float], Tuple[float, float]]
+
 class TaskConstants:
     """gamma in [0, 1), R_max > 0, M_phi > 0, |A| > 0 (Sec 3.4, Assumptions 4.1-4.2), and the
     family of c and d: "thesis" (default) or "tight" (docs/THEOREMS.md, "Tight constants")."""

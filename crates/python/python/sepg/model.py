@@ -15,7 +15,17 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from sepg._native import __version__
+from sepg._native import (
+    _DEFAULT_BUDGET0,
+    _DEFAULT_CONSTANTS,
+    _DEFAULT_DELTA,
+    _DEFAULT_N_TRAJECTORIES,
+    _DEFAULT_NU,
+    _DEFAULT_REQUIREMENT,
+    _DEFAULT_SEED,
+    _REQUIREMENTS,
+    __version__,
+)
 from sepg.callbacks import CallbackArg
 from sepg.errors import InvalidInputError
 from sepg.gym import Features, GymRun, _gymnasium
@@ -27,8 +37,6 @@ PathLike = Union[str, "os.PathLike[str]"]
 FORMAT = "sepg-model"
 #: The version of the saved-model format this code writes and reads.
 FORMAT_VERSION = 1
-
-_REQUIREMENTS = ("mi", "lb1", "lb2", "lv", "zv", "sim")
 
 
 class SEPG:
@@ -48,20 +56,20 @@ class SEPG:
         features: Optional[Features] = None,
         *,
         gamma: float,
-        requirement: str = "zv",
-        n_trajectories: int = 100,
+        requirement: str = _DEFAULT_REQUIREMENT,
+        n_trajectories: int = _DEFAULT_N_TRAJECTORIES,
         horizon: Optional[int] = None,
         r_max: Optional[float] = None,
         m_phi: Optional[float] = None,
         action_volume: Optional[float] = None,
-        seed: int = 0,
-        delta: float = 0.2,
+        seed: int = _DEFAULT_SEED,
+        delta: float = _DEFAULT_DELTA,
         v0: Optional[Sequence[float]] = None,
         sigma0: Optional[Sequence[float]] = None,
-        initial_budget: float = 0.0,
-        constants: str = "tight",
+        initial_budget: float = _DEFAULT_BUDGET0,
+        constants: str = _DEFAULT_CONSTANTS,
         rewards: Optional[str] = None,
-        nu: float = 0.5,
+        nu: float = _DEFAULT_NU,
         reference_batch: Optional[int] = None,
         accounting: str = "certified",
         v_direction: str = "greedy",

@@ -4,138 +4,13 @@
 #[cfg(feature = "clap")]
 use clap::ValueEnum;
 use sepg_algo::core::check::OnContradiction;
-use sepg_algo::core::config::Requirement;
 use sepg_algo::core::options::RewardSign;
 use sepg_mdp::rollout::ScoreAction;
 use serde::{Deserialize, Serialize};
 
-/// Environment presets accepted by `--env`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum EnvName {
-    /// Thesis Sec 5.1 as written (S, A = [−2, 2], r = −0.5(s² + a²)).
-    Lqg,
-    /// The 1-D LQG behind the thesis's numbers (S, A = [−4, 4], r = −0.9(s² + a²)).
-    Lqg1d,
-    /// Gymnasium's MountainCarContinuous-v0.
-    MountainCar,
-}
-
-impl EnvName {
-    /// The registry name.
-    pub fn name(self) -> &'static str {
-        match self {
-            EnvName::Lqg => "lqg",
-            EnvName::Lqg1d => "lqg1d",
-            EnvName::MountainCar => "mountain-car",
-        }
-    }
-}
-
-/// Algorithms accepted by `--algo`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum AlgoName {
-    /// SEPG, monotonic improvement.
-    SepgMi,
-    /// SEPG, lower-bounded I (split ν).
-    SepgLb1,
-    /// SEPG, lower-bounded II (budget).
-    SepgLb2,
-    /// SEPG, low-variance target.
-    SepgLv,
-    /// SEPG, zero-variance (deterministic) target.
-    SepgZv,
-    /// SEPG with simultaneous updates from one batch (budget split ν).
-    SepgSim,
-    /// SEPG with the naive variance update along ∇_w J (eq. 4.12).
-    SepgNaiveW,
-    /// G(PO)MDP with constant steps α, β.
-    GpomdpConst,
-    /// G(PO)MDP with Adam.
-    GpomdpAdam,
-    /// The adaptive step of Pirotta et al. with fixed σ.
-    Adastep,
-}
-
-impl AlgoName {
-    /// The name of the algorithm in configurations and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            AlgoName::SepgMi => "sepg-mi",
-            AlgoName::SepgLb1 => "sepg-lb1",
-            AlgoName::SepgLb2 => "sepg-lb2",
-            AlgoName::SepgLv => "sepg-lv",
-            AlgoName::SepgZv => "sepg-zv",
-            AlgoName::SepgSim => "sepg-sim",
-            AlgoName::SepgNaiveW => "sepg-naive-w",
-            AlgoName::GpomdpConst => "gpomdp-const",
-            AlgoName::GpomdpAdam => "gpomdp-adam",
-            AlgoName::Adastep => "adastep",
-        }
-    }
-
-    /// Whether the algorithm splits its requirement with ν (LB-I and SIM-ν, Table 4.1, also
-    /// as the requirement of `sepg-naive-w`).
-    /// Whether the algorithm is a SEPG variant (the SEPG options apply).
-    pub(super) fn is_sepg(self) -> bool {
-        matches!(
-            self,
-            AlgoName::SepgMi
-                | AlgoName::SepgLb1
-                | AlgoName::SepgLb2
-                | AlgoName::SepgLv
-                | AlgoName::SepgZv
-                | AlgoName::SepgSim
-                | AlgoName::SepgNaiveW
-        )
-    }
-
-    pub(super) fn uses_nu(self, requirement: Option<RequirementName>) -> bool {
-        matches!(self, AlgoName::SepgLb1 | AlgoName::SepgSim)
-            || (self == AlgoName::SepgNaiveW
-                && matches!(
-                    requirement,
-                    Some(RequirementName::Lb1 | RequirementName::Sim)
-                ))
-    }
-}
-
-/// Safety requirements accepted by `--requirement` (the requirement of `sepg-naive-w`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum RequirementName {
-    /// Monotonic improvement.
-    Mi,
-    /// Lower-bounded I.
-    Lb1,
-    /// Lower-bounded II.
-    Lb2,
-    /// Low variance.
-    Lv,
-    /// Zero variance.
-    Zv,
-    /// Simultaneous updates.
-    Sim,
-}
-
-impl RequirementName {
-    /// The requirement of `sepg-algo`, with the split ν of LB-I and SIM-ν (default 0.5).
-    pub(super) fn requirement(self, nu: Option<f64>) -> Requirement {
-        let nu = nu.unwrap_or(0.5);
-        match self {
-            RequirementName::Mi => Requirement::Mi,
-            RequirementName::Lb1 => Requirement::LbI { nu },
-            RequirementName::Lb2 => Requirement::LbII,
-            RequirementName::Lv => Requirement::Lv,
-            RequirementName::Zv => Requirement::Zv,
-            RequirementName::Sim => Requirement::Sim { nu },
-        }
-    }
-}
+pub use sepg_algo::core::names::{AlgoName, ConstantsName, RequirementName};
+/// Environment presets accepted by `--env` (the registry of `sepg-mdp`).
+pub use sepg_mdp::env::Preset as EnvName;
 
 /// Gradient modes accepted by `--gradients`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -282,33 +157,6 @@ pub enum ScheduleName {
     Run,
     /// δ per width (the thesis): a statement per iteration at most.
     Iteration,
-}
-
-/// The family of constants c and d of the bounds, accepted by `--constants`
-/// (docs/THEOREMS.md, "Tight constants").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum ConstantsName {
-    /// c of Theorems 3.14 / 4.2 and d of Theorem 4.3 (the thesis).
-    Thesis,
-    /// c = ρ R M_φ² S_H / σ² and d = 2ρ R S_H (Theorem T) for the run's horizon H.
-    Tight,
-}
-
-impl ConstantsName {
-    /// The family's name in configurations and reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            ConstantsName::Thesis => "thesis",
-            ConstantsName::Tight => "tight",
-        }
-    }
-
-    /// The family of a configuration written before the option existed: the thesis's.
-    pub fn legacy() -> Self {
-        ConstantsName::Thesis
-    }
 }
 
 /// What a run does when its data contradict its declared constants, accepted by

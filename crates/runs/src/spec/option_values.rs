@@ -3,6 +3,10 @@
 
 use sepg_algo::core::check::OnContradiction;
 use sepg_algo::core::config::{Algorithm, Requirement};
+use sepg_algo::core::defaults::{
+    DEFAULT_ADAM_BETA1, DEFAULT_ADAM_BETA2, DEFAULT_ADAM_EPS, DEFAULT_METAGRADIENT_CLIP,
+    DEFAULT_QUANTILE_FACTOR, RUN_CONSTANTS,
+};
 use sepg_algo::core::options::{
     Accounting, Confidence, ConstantOverrides, ConstantsFamily, Lb1Requirement, RewardSign,
     Schedule as WidthSchedule, SepgOptions, VDirection, WDirection, WStep,
@@ -32,12 +36,10 @@ impl RunSpec {
             action_volume: self.action_volume,
             psi: self.psi,
         };
-        let constants = match self.constants.unwrap_or(ConstantsName::Tight) {
-            ConstantsName::Thesis => ConstantsFamily::Thesis,
-            ConstantsName::Tight => ConstantsFamily::Tight {
-                rewards: self.rewards.map_or(env_rewards, RewardsName::sign),
-            },
-        };
+        let constants = self
+            .constants
+            .unwrap_or(RUN_CONSTANTS)
+            .family(self.rewards.map_or(env_rewards, RewardsName::sign));
         let defaults = SepgOptions::default();
         let on_contradiction = self
             .on_contradiction
@@ -69,9 +71,9 @@ impl RunSpec {
             v_direction: match (self.v_direction, self.adam_lr) {
                 (Some(VDirectionName::Adam), Some(lr)) => VDirection::Adam {
                     lr,
-                    beta1: self.adam_beta1.unwrap_or(0.9),
-                    beta2: self.adam_beta2.unwrap_or(0.999),
-                    eps: self.adam_eps.unwrap_or(1e-8),
+                    beta1: self.adam_beta1.unwrap_or(DEFAULT_ADAM_BETA1),
+                    beta2: self.adam_beta2.unwrap_or(DEFAULT_ADAM_BETA2),
+                    eps: self.adam_eps.unwrap_or(DEFAULT_ADAM_EPS),
                 },
                 _ => defaults.v_direction,
             },
@@ -83,14 +85,14 @@ impl RunSpec {
             w_direction: match self.w_direction {
                 Some(WDirectionName::PlugIn) => WDirection::PlugIn,
                 Some(WDirectionName::Metagradient) => WDirection::Metagradient {
-                    clip: self.metagradient_clip.unwrap_or(100.0),
+                    clip: self.metagradient_clip.unwrap_or(DEFAULT_METAGRADIENT_CLIP),
                 },
                 Some(WDirectionName::CrossFitted) | None => defaults.w_direction,
             },
             confidence: match self.confidence {
                 Some(ConfidenceName::None) => Confidence::None,
                 Some(ConfidenceName::StudentT) => Confidence::StudentT {
-                    factor: self.quantile_factor.unwrap_or(1.0),
+                    factor: self.quantile_factor.unwrap_or(DEFAULT_QUANTILE_FACTOR),
                 },
                 Some(ConfidenceName::SubGaussian) | None => defaults.confidence,
             },

@@ -2,6 +2,10 @@
 //! schedule of a run, and its environment.
 
 use sepg_algo::core::config::{Algorithm, GradientMode, SepgConfig, reward_sign};
+use sepg_algo::core::defaults::{
+    DEFAULT_ALGO, DEFAULT_BUDGET0, DEFAULT_DELTA, DEFAULT_ITERATIONS, DEFAULT_N_TRAJECTORIES,
+    DEFAULT_NU, DEFAULT_REQUIREMENT, DEFAULT_SEED, DEFAULT_SIGMA0, DEFAULT_V0,
+};
 use sepg_estimators::{Baseline, BaselineFit, GradientSpec, Kind};
 use sepg_mdp::env::{AnyEnv, Environment, LqgEnv};
 use sepg_mdp::mountain_car::MountainCar;
@@ -28,7 +32,7 @@ impl RunSpec {
     /// [`Error::Invalid`] for any invalid or inapplicable option.
     pub fn resolve(&self) -> Result<Resolved> {
         let env_name = self.env.unwrap_or(EnvName::Lqg);
-        let algo = self.algo.unwrap_or(AlgoName::SepgZv);
+        let algo = self.algo.unwrap_or(DEFAULT_ALGO);
         let gradients = self.gradients.unwrap_or(GradientsName::Sampled);
         let env = build_env(env_name, self.features.as_deref())?;
         let features = self.features_of(env_name)?;
@@ -131,9 +135,9 @@ impl RunSpec {
     fn method(&self, algo: AlgoName) -> Result<Method> {
         let nu = algo
             .uses_nu(self.requirement)
-            .then(|| self.nu.unwrap_or(0.5));
+            .then(|| self.nu.unwrap_or(DEFAULT_NU));
         let requirement =
-            (algo == AlgoName::SepgNaiveW).then(|| self.requirement.unwrap_or(RequirementName::Zv));
+            (algo == AlgoName::SepgNaiveW).then(|| self.requirement.unwrap_or(DEFAULT_REQUIREMENT));
         let need = |v: Option<f64>, flag: &str| {
             v.ok_or_else(|| Error::invalid(format!("algorithm {} needs --{flag}", algo.name())))
         };
@@ -155,7 +159,7 @@ impl RunSpec {
             AlgoName::SepgZv => sepg(RequirementName::Zv),
             AlgoName::SepgSim => sepg(RequirementName::Sim),
             AlgoName::SepgNaiveW => {
-                Algorithm::SepgNaiveW(requirement.unwrap_or(RequirementName::Zv).requirement(nu))
+                Algorithm::SepgNaiveW(requirement.unwrap_or(DEFAULT_REQUIREMENT).requirement(nu))
             }
             AlgoName::GpomdpConst => {
                 let alpha = need(self.alpha, "alpha")?;
@@ -180,7 +184,7 @@ impl RunSpec {
             return Sampling(None);
         }
         Sampling(Some((
-            self.delta.unwrap_or(0.2),
+            self.delta.unwrap_or(DEFAULT_DELTA),
             self.estimator.unwrap_or(EstimatorName::Gpomdp),
             self.baseline.unwrap_or(BaselineName::Optimal),
             self.baseline_fit.unwrap_or(FitName::LeaveOneOut),
@@ -193,17 +197,18 @@ impl RunSpec {
         let v0 = self
             .v0
             .clone()
-            .unwrap_or(Values::One(-0.1))
+            .unwrap_or(Values::One(DEFAULT_V0))
             .expand(dim_v, "v0")?;
         let sigma0 = self
             .sigma0
             .clone()
-            .unwrap_or(Values::One(1.0))
+            .unwrap_or(Values::One(DEFAULT_SIGMA0))
             .expand(dim_w, "sigma0")?;
+        // Mountain Car starts with a budget of 1 (Fig 5.4), the LQG presets with none.
         let budget0 = self.budget0.unwrap_or(if env == EnvName::MountainCar {
             1.0
         } else {
-            0.0
+            DEFAULT_BUDGET0
         });
         Ok(Start {
             v0,
@@ -215,7 +220,7 @@ impl RunSpec {
     /// Batch size, horizon (default: the environment's `default_horizon`), iterations, seed
     /// and log stride.
     fn schedule(&self, default_horizon: usize) -> Result<Schedule> {
-        let batch = self.batch.unwrap_or(100);
+        let batch = self.batch.unwrap_or(DEFAULT_N_TRAJECTORIES);
         if batch < 2 {
             return Err(Error::invalid(format!(
                 "batch N = {batch} must be at least 2"
@@ -225,8 +230,8 @@ impl RunSpec {
         let schedule = Schedule {
             batch,
             horizon: self.horizon.unwrap_or(default_horizon),
-            iterations: self.iterations.unwrap_or(10_000),
-            seed: self.seed.unwrap_or(0),
+            iterations: self.iterations.unwrap_or(DEFAULT_ITERATIONS),
+            seed: self.seed.unwrap_or(DEFAULT_SEED),
             log_every,
         };
         if log_every == 0 {
