@@ -45,7 +45,8 @@
 //! intervals of initial states on which the trajectory is affine in `s_0` (piecewise-linear
 //! closed-loop map), integrating the quadratic rewards exactly on each interval.
 
-use super::quadrature::{GaussLegendre, norm_cdf, norm_pdf, normal_moments};
+use super::jet::Dual;
+use super::quadrature::{Chebyshev, GaussLegendre, dot, norm_cdf, norm_pdf, normal_moments};
 use super::{ExactEval, ExactOracle, Exploration, Horizon, Needs, OracleError, check_params};
 use crate::lqg_model::LqgModel;
 use nalgebra::DMatrix;
@@ -63,7 +64,7 @@ const KINK_WEIGHT: f64 = 1e-16;
 /// Maximal number of exact kinks of the value function tracked.
 const MAX_KINKS: usize = 4096;
 /// Maximal number of Chebyshev nodes per element.
-pub const MAX_NODES: usize = 32;
+pub(crate) const MAX_NODES: usize = 32;
 /// Maximal number of initial-state intervals of the exact deterministic method.
 const MAX_PIECES: usize = 1_000_000;
 
@@ -89,7 +90,7 @@ const MAX_PIECES: usize = 1_000_000;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DpConfig {
-    /// Chebyshev nodes per element (polynomial degree + 1), in `2..=MAX_NODES`.
+    /// Chebyshev nodes per element (polynomial degree + 1), in `2..=32`.
     pub nodes_per_element: usize,
     /// Gauss–Legendre points per quadrature piece, at least 2.
     pub quad_points: usize,
@@ -162,8 +163,7 @@ pub struct ClippedDpOracle {
     i_hi: f64,
     config: DpConfig,
     gl: GaussLegendre,
-    cheb: Vec<f64>,
-    bary: Vec<f64>,
+    cheb: Chebyshev,
 }
 
 /// A smoothed feature of the value function: centre and scale.
@@ -250,23 +250,6 @@ impl SpanOp {
                 .sum();
         }
     }
-}
-
-/// `Σ a_i b_i` with four independent partial sums (a fixed order: deterministic).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let (ca, ra) = a.as_chunks::<4>();
-    let (cb, rb) = b.as_chunks::<4>();
-    let (mut s0, mut s1, mut s2, mut s3) = (0.0, 0.0, 0.0, 0.0);
-    for (x, y) in ca.iter().zip(cb) {
-        s0 += x[0] * y[0];
-        s1 += x[1] * y[1];
-        s2 += x[2] * y[2];
-        s3 += x[3] * y[3];
-    }
-    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
-    (s0 + s2) + (s1 + s3) + tail
 }
 
 /// Dense row accumulator for building a [`SpanOp`].
@@ -362,13 +345,40 @@ impl Quad {
             for i in 0..sub {
                 for x in &o.gl.nodes {
                     let tq = -1.0 + (2 * i + 1) as f64 / sub as f64 + x / sub as f64;
-                    o.lagrange(tq, &mut self.lw);
+                    o.cheb.weights(tq, &mut self.lw);
                     tab.extend_from_slice(&self.lw[..p]);
                 }
             }
             self.tables[sub] = tab;
         }
         Some(&self.tables[sub])
+    }
+}
+
+/// The integrals `Σ weight · φ(z) z^k · l_j` of one segment of [`ClippedDpOracle::add_gauss`],
+/// per power `k < kmax` and node `j < p` of its element.
+struct SegmentSums {
+    sums: [[f64; MAX_NODES]; 5],
+    kmax: usize,
+    p: usize,
+}
+
+impl SegmentSums {
+    /// Adds the quadrature point `z` of weight `weight`, `l` the interpolation weights of
+    /// the element's nodes at the point.
+    fn add(&mut self, z: f64, weight: f64, l: &[f64]) {
+        let base = weight * norm_pdf(z);
+        let mut coef = [0.0; 5];
+        let mut zk = 1.0;
+        for c in coef.iter_mut().take(self.kmax) {
+            *c = base * zk;
+            zk *= z;
+        }
+        for (lk, &ck) in self.sums.iter_mut().zip(&coef[..self.kmax]) {
+            for (a, &lj) in lk[..self.p].iter_mut().zip(l) {
+                *a += ck * lj;
+            }
+        }
     }
 }
 
@@ -424,37 +434,6 @@ struct Target<'g> {
     clip: Option<(f64, f64)>,
 }
 
-/// A first-order dual number `x + x' ε` in the mean parameter `v`.
-#[derive(Debug, Clone, Copy)]
-struct Dual {
-    x: f64,
-    d: f64,
-}
-
-impl Dual {
-    fn c(x: f64) -> Self {
-        Dual { x, d: 0.0 }
-    }
-    fn add(self, o: Dual) -> Dual {
-        Dual {
-            x: self.x + o.x,
-            d: self.d + o.d,
-        }
-    }
-    fn mul(self, o: Dual) -> Dual {
-        Dual {
-            x: self.x * o.x,
-            d: self.d * o.x + self.x * o.d,
-        }
-    }
-    fn scale(self, c: f64) -> Dual {
-        Dual {
-            x: self.x * c,
-            d: self.d * c,
-        }
-    }
-}
-
 /// An interval of initial states on which `s_t = α s_0 + β` (exact deterministic method).
 #[derive(Debug, Clone, Copy)]
 struct Piece {
@@ -508,13 +487,6 @@ impl ClippedDpOracle {
         if model.b[(0, 0)] == 0.0 {
             return Err(OracleError::Unsupported("B = 0: the action has no effect"));
         }
-        let p = config.nodes_per_element;
-        let pf = p as f64;
-        let theta = |j: usize| std::f64::consts::PI * (2 * j + 1) as f64 / (2.0 * pf);
-        let cheb = (0..p).map(|j| theta(j).cos()).collect();
-        let bary = (0..p)
-            .map(|j| if j % 2 == 0 { 1.0 } else { -1.0 } * theta(j).sin())
-            .collect();
         Ok(ClippedDpOracle {
             a: model.a[(0, 0)],
             b: model.b[(0, 0)],
@@ -530,8 +502,7 @@ impl ClippedDpOracle {
             i_hi: model.init_high[0],
             config,
             gl: GaussLegendre::new(config.quad_points),
-            cheb,
-            bary,
+            cheb: Chebyshev::new(config.nodes_per_element),
         })
     }
 
@@ -620,7 +591,7 @@ impl ClippedDpOracle {
         let mut nodes = Vec::with_capacity((breaks.len() - 1) * p);
         for w in breaks.windows(2) {
             let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            nodes.extend(self.cheb.iter().map(|x| mid + half * x));
+            nodes.extend(self.cheb.nodes.iter().map(|x| mid + half * x));
         }
         Grid { breaks, nodes, p }
     }
@@ -636,25 +607,8 @@ impl ClippedDpOracle {
     /// Barycentric interpolation weights at `y` on element `e` into `out[..p]`.
     fn weights_in(&self, grid: &Grid, e: usize, y: f64, out: &mut [f64]) {
         let (b0, b1) = (grid.breaks[e], grid.breaks[e + 1]);
-        self.lagrange(((2.0 * y - b0 - b1) / (b1 - b0)).clamp(-1.0, 1.0), out);
-    }
-
-    /// Weights of the Chebyshev nodes at `t ∈ [−1, 1]` (barycentric formula) into `out[..p]`.
-    fn lagrange(&self, t: f64, out: &mut [f64]) {
-        let p = self.cheb.len();
-        let mut total = 0.0;
-        for j in 0..p {
-            let d = t - self.cheb[j];
-            if d == 0.0 {
-                out[..p].iter_mut().for_each(|x| *x = 0.0);
-                out[j] = 1.0;
-                return;
-            }
-            out[j] = self.bary[j] / d;
-            total += out[j];
-        }
-        let inv = 1.0 / total;
-        out[..p].iter_mut().for_each(|x| *x *= inv);
+        self.cheb
+            .weights(((2.0 * y - b0 - b1) / (b1 - b0)).clamp(-1.0, 1.0), out);
     }
 
     /// Barycentric interpolation weights at `y` (clamped to the grid) into `out`; returns the
@@ -684,11 +638,8 @@ impl ClippedDpOracle {
     /// Adds `∫_{z0}^{z1} z^k φ(z) f(clip(y0 + y1 z)) dz` (`k < kmax`) to the row, the range
     /// truncated to `|z| ≤ Z_MAX`.
     ///
-    /// The range is cut at the clip points and at the element boundaries. A piece between
-    /// element boundaries or the truncation points is integrated with the element's fixed
-    /// sub-pieces ([`Quad::table`], no per-point interpolation weights); a piece ending at a
-    /// clip point or at `z0`, `z1` inside the truncation range, with unit-width pieces in `z`
-    /// and barycentric weights.
+    /// The range is cut at the clip points and at the element boundaries ([`Self::cuts`]),
+    /// and each piece is integrated by [`Self::add_segment`].
     #[allow(clippy::too_many_arguments)]
     fn add_gauss(
         &self,
@@ -712,9 +663,29 @@ impl ClippedDpOracle {
             self.add_point(row, t, y0, &m[..kmax], &mut quad.lw);
             return;
         }
+        let mut cuts = std::mem::take(&mut quad.cuts);
+        Self::cuts(t, (y0, y1), (z0, hard0), (z1, hard1), &mut cuts);
+        for w in cuts.windows(2) {
+            if w[1].0 <= w[0].0 {
+                continue;
+            }
+            self.add_segment(row, t, (y0, y1), (w[0], w[1]), kmax, quad);
+        }
+        quad.cuts = cuts;
+    }
+
+    /// The points cutting `[z0, z1]` into `cuts`, sorted: the ends, where `y0 + y1 z` meets a
+    /// clip point, and where it crosses an element boundary of the grid, each with whether
+    /// the integrand is discontinuous there (the ends when inside the truncation range, the
+    /// clip points).
+    fn cuts(
+        t: &Target<'_>,
+        (y0, y1): (f64, f64),
+        (z0, hard0): (f64, bool),
+        (z1, hard1): (f64, bool),
+        cuts: &mut Vec<(f64, bool)>,
+    ) {
         let zof = |y: f64| (y - y0) / y1;
-        // (z, whether the integrand is discontinuous there)
-        let cuts = &mut quad.cuts;
         cuts.clear();
         cuts.extend([(z0, hard0), (z1, hard1)]);
         let (ya, yb) = {
@@ -739,91 +710,104 @@ impl ClippedDpOracle {
             }
         }
         cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let cuts = std::mem::take(&mut quad.cuts);
-        let mut coef = [0.0; 5];
+    }
+
+    /// Adds the integral over one piece `[za, zb]` between two cuts (`ha`, `hb`: whether the
+    /// integrand is discontinuous at its ends). A piece whose next state is clipped is a point
+    /// mass; otherwise it lies in one element of the grid and is integrated with the element's
+    /// fixed sub-pieces ([`Quad::table`], no per-point interpolation weights) when both ends
+    /// are continuous, else with pieces at most [`PIECE_WIDTH`] wide in `z` and barycentric
+    /// weights.
+    fn add_segment(
+        &self,
+        row: &mut RowAcc,
+        t: &Target<'_>,
+        (y0, y1): (f64, f64),
+        ((za, ha), (zb, hb)): ((f64, bool), (f64, bool)),
+        kmax: usize,
+        quad: &mut Quad,
+    ) {
+        let ymid = y0 + y1 * 0.5 * (za + zb);
+        if let Some((lo, hi)) = t.clip
+            && (ymid < lo || ymid > hi)
+        {
+            let m = normal_moments(za, zb);
+            self.add_point(row, t, ymid, &m[..kmax], &mut quad.lw);
+            return;
+        }
+        // The segment lies in one element: accumulate locally, flush once.
+        let e = Self::element(
+            t.grid,
+            ymid.clamp(t.grid.breaks[0], t.grid.breaks[t.grid.breaks.len() - 1]),
+        );
         let p = t.grid.p;
-        for w in cuts.windows(2) {
-            let ((za, ha), (zb, hb)) = (w[0], w[1]);
-            if zb <= za {
-                continue;
-            }
-            let ymid = y0 + y1 * 0.5 * (za + zb);
-            if let Some((lo, hi)) = t.clip
-                && (ymid < lo || ymid > hi)
-            {
-                let m = normal_moments(za, zb);
-                self.add_point(row, t, ymid, &m[..kmax], &mut quad.lw);
-                continue;
-            }
-            // The segment lies in one element: accumulate locally, flush once.
-            let e = Self::element(
-                t.grid,
-                ymid.clamp(t.grid.breaks[0], t.grid.breaks[t.grid.breaks.len() - 1]),
-            );
-            let mut local = [[0.0; MAX_NODES]; 5];
-            let mut acc = |z: f64, weight: f64, l: &[f64]| {
-                let base = weight * norm_pdf(z);
-                let mut zk = 1.0;
-                for c in coef.iter_mut().take(kmax) {
-                    *c = base * zk;
-                    zk *= z;
-                }
-                for (lk, &ck) in local.iter_mut().zip(&coef[..kmax]) {
-                    for (a, &lj) in lk[..p].iter_mut().zip(l) {
-                        *a += ck * lj;
-                    }
-                }
-            };
-            let (b0, b1) = (t.grid.breaks[e], t.grid.breaks[e + 1]);
-            let (mid_e, half_e) = (0.5 * (b0 + b1), 0.5 * (b1 - b0));
-            let sub = ((b1 - b0) / (y1.abs() * PIECE_WIDTH)).ceil();
-            let table = if !ha && !hb && sub <= MAX_SUB_PIECES as f64 {
-                quad.table(self, sub.max(1.0) as usize)
-            } else {
-                None
-            };
-            if let Some(table) = table {
-                // Fixed sub-pieces of the element (at most one unit wide in z) that meet the
-                // segment; the ends are element boundaries or the truncation points, where
-                // the integrand is continuous and negligible respectively.
-                let nsub = sub.max(1.0) as usize;
-                let tof = |z: f64| ((y0 + y1 * z - mid_e) / half_e).clamp(-1.0, 1.0);
-                let (ta, tb) = {
-                    let (u, v) = (tof(za), tof(zb));
-                    (u.min(v), u.max(v))
-                };
-                let scale = 0.5 * nsub as f64;
-                let i0 = ((ta + 1.0) * scale).floor() as usize;
-                let i1 = (((tb + 1.0) * scale).ceil() as usize).clamp(i0 + 1, nsub);
-                let nq = self.gl.nodes.len();
-                let dz = half_e / (nsub as f64 * y1.abs());
-                for i in i0..i1 {
-                    for (q, (x, wq)) in self.gl.nodes.iter().zip(&self.gl.weights).enumerate() {
-                        let tq = -1.0 + (2 * i + 1) as f64 / nsub as f64 + x / nsub as f64;
-                        let z = (mid_e + half_e * tq - y0) / y1;
-                        acc(z, wq * dz, &table[(i * nq + q) * p..][..p]);
-                    }
-                }
-            } else {
-                let pieces = ((zb - za) / PIECE_WIDTH).ceil().max(1.0);
-                let hz = (zb - za) / pieces;
-                for i in 0..pieces as usize {
-                    let pa = za + hz * i as f64;
-                    let (mid, half) = (pa + 0.5 * hz, 0.5 * hz);
-                    for (x, wq) in self.gl.nodes.iter().zip(&self.gl.weights) {
-                        let z = mid + half * x;
-                        self.weights_in(t.grid, e, y0 + y1 * z, &mut quad.lw);
-                        acc(z, wq * half, &quad.lw[..p]);
-                    }
-                }
-            }
-            for (k, lk) in local[..kmax].iter().enumerate() {
-                for (j, &x) in lk[..p].iter().enumerate() {
-                    row.add(e * p + j, k, x);
+        let mut local = SegmentSums {
+            sums: [[0.0; MAX_NODES]; 5],
+            kmax,
+            p,
+        };
+        let (b0, b1) = (t.grid.breaks[e], t.grid.breaks[e + 1]);
+        let sub = ((b1 - b0) / (y1.abs() * PIECE_WIDTH)).ceil();
+        let table = if !ha && !hb && sub <= MAX_SUB_PIECES as f64 {
+            quad.table(self, sub.max(1.0) as usize)
+        } else {
+            None
+        };
+        if let Some(table) = table {
+            self.sum_sub_pieces(&mut local, (b0, b1), (y0, y1), (za, zb), sub, table);
+        } else {
+            let pieces = ((zb - za) / PIECE_WIDTH).ceil().max(1.0);
+            let hz = (zb - za) / pieces;
+            for i in 0..pieces as usize {
+                let pa = za + hz * i as f64;
+                let (mid, half) = (pa + 0.5 * hz, 0.5 * hz);
+                for (x, wq) in self.gl.nodes.iter().zip(&self.gl.weights) {
+                    let z = mid + half * x;
+                    self.weights_in(t.grid, e, y0 + y1 * z, &mut quad.lw);
+                    local.add(z, wq * half, &quad.lw[..p]);
                 }
             }
         }
-        quad.cuts = cuts;
+        for (k, lk) in local.sums[..kmax].iter().enumerate() {
+            for (j, &x) in lk[..p].iter().enumerate() {
+                row.add(e * p + j, k, x);
+            }
+        }
+    }
+
+    /// The fixed sub-pieces (`sub` of them, each at most one unit wide in `z`) of the element
+    /// `[b0, b1]` that meet the segment `[za, zb]`, with the interpolation weights `table` of
+    /// [`Quad::table`]. The ends of the segment are element boundaries or the truncation
+    /// points, where the integrand is continuous and negligible respectively.
+    fn sum_sub_pieces(
+        &self,
+        local: &mut SegmentSums,
+        (b0, b1): (f64, f64),
+        (y0, y1): (f64, f64),
+        (za, zb): (f64, f64),
+        sub: f64,
+        table: &[f64],
+    ) {
+        let p = local.p;
+        let (mid_e, half_e) = (0.5 * (b0 + b1), 0.5 * (b1 - b0));
+        let nsub = sub.max(1.0) as usize;
+        let tof = |z: f64| ((y0 + y1 * z - mid_e) / half_e).clamp(-1.0, 1.0);
+        let (ta, tb) = {
+            let (u, v) = (tof(za), tof(zb));
+            (u.min(v), u.max(v))
+        };
+        let scale = 0.5 * nsub as f64;
+        let i0 = ((ta + 1.0) * scale).floor() as usize;
+        let i1 = (((tb + 1.0) * scale).ceil() as usize).clamp(i0 + 1, nsub);
+        let nq = self.gl.nodes.len();
+        let dz = half_e / (nsub as f64 * y1.abs());
+        for i in i0..i1 {
+            for (q, (x, wq)) in self.gl.nodes.iter().zip(&self.gl.weights).enumerate() {
+                let tq = -1.0 + (2 * i + 1) as f64 / nsub as f64 + x / nsub as f64;
+                let z = (mid_e + half_e * tq - y0) / y1;
+                local.add(z, wq * dz, &table[(i * nq + q) * p..][..p]);
+            }
+        }
     }
 
     // ---------------------------------------------------------------- features
@@ -1265,7 +1249,6 @@ impl ClippedDpOracle {
             alpha: Dual::c(1.0),
             beta: Dual::c(0.0),
         }];
-        let gl2 = [-(1.0f64 / 3.0).sqrt(), (1.0f64 / 3.0).sqrt()];
         let mut j = Dual::c(0.0);
         let mut disc = 1.0;
         let action_kinks: Vec<f64> = if v == 0.0 {
@@ -1280,43 +1263,12 @@ impl ClippedDpOracle {
             let mut next = Vec::with_capacity(pieces.len());
             for pc in &pieces {
                 for (l0, l1) in split(pc.lo, pc.hi, pc.alpha.x, pc.beta.x, &action_kinks) {
-                    let mid = 0.5 * (l0 + l1);
-                    let s_mid = pc.alpha.x * mid + pc.beta.x;
-                    let u = v * s_mid;
-                    // a_c = ca·s0 + cb (dual coefficients)
-                    let (ca, cb) = if u <= self.a_lo {
-                        (Dual::c(0.0), Dual::c(self.a_lo))
-                    } else if u >= self.a_hi {
-                        (Dual::c(0.0), Dual::c(self.a_hi))
-                    } else {
-                        (vd.mul(pc.alpha), vd.mul(pc.beta))
-                    };
                     let weight = if width > 0.0 { (l1 - l0) / width } else { 1.0 };
-                    for x in gl2 {
-                        let s0 = Dual::c(mid + 0.5 * (l1 - l0) * x);
-                        let s = pc.alpha.mul(s0).add(pc.beta);
-                        let a = ca.mul(s0).add(cb);
-                        let rwd = s.mul(s).scale(-self.q).add(a.mul(a).scale(-self.r));
+                    let (ca, cb) = self.clipped_action(pc, vd, 0.5 * (l0 + l1));
+                    for rwd in self.node_rewards(pc, (ca, cb), (l0, l1)) {
                         j = j.add(rwd.scale(0.5 * weight * disc));
                     }
-                    let ya = pc.alpha.scale(self.a).add(ca.scale(self.b));
-                    let yb = pc.beta.scale(self.a).add(cb.scale(self.b));
-                    for (m0, m1) in split(l0, l1, ya.x, yb.x, &[self.s_lo, self.s_hi]) {
-                        let y_mid = ya.x * 0.5 * (m0 + m1) + yb.x;
-                        let (alpha, beta) = if y_mid <= self.s_lo {
-                            (Dual::c(0.0), Dual::c(self.s_lo))
-                        } else if y_mid >= self.s_hi {
-                            (Dual::c(0.0), Dual::c(self.s_hi))
-                        } else {
-                            (ya, yb)
-                        };
-                        next.push(Piece {
-                            lo: m0,
-                            hi: m1,
-                            alpha,
-                            beta,
-                        });
-                    }
+                    self.next_pieces(pc, (ca, cb), (l0, l1), &mut next);
                 }
             }
             if next.len() > MAX_PIECES {
@@ -1336,6 +1288,63 @@ impl ClippedDpOracle {
             hessian: None,
             sigma: Vec::new(),
         })
+    }
+
+    /// The action `a_c = ca·s₀ + cb` on the piece `pc` of initial states (dual coefficients
+    /// in `v`; `vd` = v with derivative 1), clipped or not as at the initial state `mid`: the
+    /// piece is split at the action kinks, so one side holds on all of it.
+    fn clipped_action(&self, pc: &Piece, vd: Dual, mid: f64) -> (Dual, Dual) {
+        let s_mid = pc.alpha.x * mid + pc.beta.x;
+        let u = vd.x * s_mid;
+        if u <= self.a_lo {
+            (Dual::c(0.0), Dual::c(self.a_lo))
+        } else if u >= self.a_hi {
+            (Dual::c(0.0), Dual::c(self.a_hi))
+        } else {
+            (vd.mul(pc.alpha), vd.mul(pc.beta))
+        }
+    }
+
+    /// The rewards `r(s(s₀), a(s₀))` at the 2-point Gauss–Legendre nodes `s₀` of `[l0, l1]`
+    /// (exact for the quadratic reward), `s = α s₀ + β` on the piece `pc`, `a = ca s₀ + cb`.
+    fn node_rewards(&self, pc: &Piece, (ca, cb): (Dual, Dual), (l0, l1): (f64, f64)) -> [Dual; 2] {
+        let gl2 = [-(1.0f64 / 3.0).sqrt(), (1.0f64 / 3.0).sqrt()];
+        let mid = 0.5 * (l0 + l1);
+        gl2.map(|x| {
+            let s0 = Dual::c(mid + 0.5 * (l1 - l0) * x);
+            let s = pc.alpha.mul(s0).add(pc.beta);
+            let a = ca.mul(s0).add(cb);
+            s.mul(s).scale(-self.q).add(a.mul(a).scale(-self.r))
+        })
+    }
+
+    /// The pieces of `[l0, l1]` after one step, `s' = clip(A s + B a_c)`: split where the
+    /// unclipped next state crosses a state bound, clipped pieces constant.
+    fn next_pieces(
+        &self,
+        pc: &Piece,
+        (ca, cb): (Dual, Dual),
+        (l0, l1): (f64, f64),
+        next: &mut Vec<Piece>,
+    ) {
+        let ya = pc.alpha.scale(self.a).add(ca.scale(self.b));
+        let yb = pc.beta.scale(self.a).add(cb.scale(self.b));
+        for (m0, m1) in split(l0, l1, ya.x, yb.x, &[self.s_lo, self.s_hi]) {
+            let y_mid = ya.x * 0.5 * (m0 + m1) + yb.x;
+            let (alpha, beta) = if y_mid <= self.s_lo {
+                (Dual::c(0.0), Dual::c(self.s_lo))
+            } else if y_mid >= self.s_hi {
+                (Dual::c(0.0), Dual::c(self.s_hi))
+            } else {
+                (ya, yb)
+            };
+            next.push(Piece {
+                lo: m0,
+                hi: m1,
+                alpha,
+                beta,
+            });
+        }
     }
 }
 
