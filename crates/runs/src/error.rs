@@ -11,8 +11,8 @@ pub type Source = Box<dyn std::error::Error + Send + Sync + 'static>;
 /// failed), that error as its source.
 ///
 /// The message is complete on its own (it already quotes the source where the command line
-/// shows it), so printing the message alone loses nothing; [`Message::source`] lets a caller
-/// walk the chain to the original error.
+/// shows it), so printing the message alone loses nothing; its
+/// [`source`](std::error::Error::source) lets a caller walk the chain to the original error.
 #[derive(Debug, thiserror::Error)]
 #[error("{text}")]
 pub struct Message {

@@ -24,8 +24,10 @@
 //! judged.
 //!
 //! # Exact J and the tolerance
-//! J is recomputed for every logged point with [`ClippedDpOracle`] at [`audit_dp_config`]
-//! (the clipped `lqg`, `lqg1d` presets) or [`ClosedFormOracle`] (unclipped models), in
+//! J is recomputed for every logged point with
+//! [`ClippedDpOracle`](sepg_mdp::oracle::ClippedDpOracle) at [`audit_dp_config`]
+//! (the clipped `lqg`, `lqg1d` presets) or
+//! [`ClosedFormOracle`](sepg_mdp::oracle::ClosedFormOracle) (unclipped models), in
 //! parallel over the points: each value is a pure function of its point, so the report does
 //! not depend on the number of threads. A check compares two exact values (a difference of J
 //! with a guarantee, or J with a floor); it fails when its shortfall `required − actual`
@@ -65,7 +67,7 @@
 //! [`Verdict::NoGuarantee`]. A summary written before statements were recorded is read as
 //! scope `iteration`, kind `approximate` (kind `none` for runs that promise nothing); an
 //! unfinished run is judged by the statement its configuration gives. The run's own
-//! bookkeeping ([`SelfCheck`]) is reported beside the verdict, not in it.
+//! bookkeeping ([`SelfCheck`](sepg_algo::core::statement::SelfCheck)) is reported beside the verdict, not in it.
 //!
 //! # Malformed input
 //! The log must be complete and well-formed: the header of the run's dimensions, every cell a
@@ -115,7 +117,7 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-12;
 /// Chebyshev nodes per element of the dynamic programme the audit evaluates J with.
 pub const AUDIT_NODES_PER_ELEMENT: usize = 14;
 
-/// The resolution of [`ClippedDpOracle`] used by the audit: [`DpConfig::default`] with
+/// The resolution of [`ClippedDpOracle`](sepg_mdp::oracle::ClippedDpOracle) used by the audit: [`DpConfig::default`] with
 /// [`AUDIT_NODES_PER_ELEMENT`] nodes per element. Measured against a DP with 24 nodes, 2.5
 /// times narrower elements and 16 quadrature points on 240 random pairs of both presets
 /// (v ∈ [−1.5, 0.2], σ ∈ [0.02, 2], steps from 1e-9 to 1, H = 20), its error on J is at most
