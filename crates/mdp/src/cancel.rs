@@ -1,9 +1,9 @@
 //! A process-wide request to cancel long computations: the rollout engine checks it once per
-//! chunk of [`CHUNK`](crate::rollout::CHUNK) trajectories and the clipped dynamic programme
-//! once per horizon step, and both return a `Cancelled` error once it is raised, so that a
-//! program can stop within a fraction of a second in the middle of an iteration (the `sepg`
-//! command line raises it on Ctrl-C). A computation that completes returns exactly what it
-//! returns without the check: the request only ever discards work.
+//! chunk of 64 trajectories and the clipped dynamic programme once per horizon step, and both
+//! return a `Cancelled` error once it is raised, so that a program can stop within a fraction
+//! of a second in the middle of an iteration (the `sepg` command line raises it on Ctrl-C). A
+//! computation that completes returns exactly what it returns without the check: the request
+//! only ever discards work.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -21,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 
 /// Largest dimension for which [`LqgModel::r_max`] enumerates every box corner exactly
 /// (`2^16` corners); above it a guaranteed upper bound is returned instead.
-pub const EXACT_CORNER_MAX_DIM: usize = 16;
+pub(crate) const EXACT_CORNER_MAX_DIM: usize = 16;
 
 /// Relative tolerance used to accept `Q` and `R` as symmetric and positive semi-definite.
 const PSD_TOL: f64 = 1e-10;
@@ -462,7 +462,7 @@ impl LqgModel {
 
     /// `R_max`, the largest |reward| over the state and action boxes (the constant of
     /// Theorem 4.3 and Sec 5.1). The cost is a sum of two convex quadratics, so each maximum
-    /// over a box is reached at a corner; for dimensions up to [`EXACT_CORNER_MAX_DIM`] every
+    /// over a box is reached at a corner; for dimensions up to 16 (`2^16` corners) every
     /// corner is enumerated (exact), above it the upper bound `Σ_ij |Q_ij| m_i m_j` with
     /// `m_i = max(|low_i|, |high_i|)` is returned.
     ///

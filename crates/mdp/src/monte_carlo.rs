@@ -39,12 +39,19 @@ use crate::rollout::{RolloutError, ScoreAction, Scratch};
 use crate::stream::{StepBaseline, Streamer};
 
 /// Number of consecutive trajectories in one streamed work item.
+///
+/// Public because it fixes the order of the streamed sums, hence their last bits: a caller
+/// comparing streamed estimates with sums of its own (the crate's tests cross block
+/// boundaries this way) needs it.
 pub const BLOCK: usize = 1024;
 
 /// Number of work items run in parallel before their results are merged.
 const ROUND: usize = 64;
 
 /// Default size of the pilot batch that fits the baseline of [`stream_gradients`].
+///
+/// Public because `stream_gradients` takes the pilot size as an argument and its callers
+/// (`sepg estimate`, the benchmarks) use this default.
 pub const DEFAULT_PILOT: usize = 4096;
 
 /// Errors of the Monte Carlo oracle.

@@ -4,7 +4,7 @@
 //! Trajectory `i` of a batch draws only from its own streams `key.rngs(i)`
 //! ([`crate::rng::SeedKey`]), and every output value is written by exactly one trajectory, with
 //! no floating-point reduction across threads. The result is therefore bit-identical for any
-//! number of rayon threads. Work is split in fixed chunks of [`CHUNK`] trajectories.
+//! number of rayon threads. Work is split in fixed chunks of 64 trajectories.
 //!
 //! For a one-dimensional LQG ([`Environment::as_scalar_lqg`]) a fused scalar kernel runs
 //! instead of the generic one; both perform the same floating-point operations in the same
@@ -31,7 +31,7 @@ use crate::rng::{SeedKey, TrajectoryRngs, rngs_from_prefix, standard_normal, uni
 use crate::stream::Streamer;
 
 /// Number of trajectories in one parallel work item.
-pub const CHUNK: usize = 64;
+pub(crate) const CHUNK: usize = 64;
 
 /// Which action the policy scores `∇_v log π(a|s)`, `∇_w log π(a|s)` of a scored rollout are
 /// evaluated at (Sec 2.3.1; the policy scores of Sec 4.3.4).

@@ -860,6 +860,9 @@ fn finite_points<'a>(
         .map(|(&x, &y)| (x, y))
 }
 
+/// The chart of one panel: the ticked abscissa against a linear ordinate.
+type PanelChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<TickedAxis, RangedCoordf64>>;
+
 fn draw_panel<DB: DrawingBackend>(
     cell: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -870,20 +873,7 @@ fn draw_panel<DB: DrawingBackend>(
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let (x0, x1, y0, y1) = range(panel);
     let ((x0, x1), x_ticks) = ticks(x0, x1);
-    // The caption, drawn with its subscripts, centred above the chart.
-    let caption = style.text(16.0);
-    let caption_h = (caption * 1.6).round() as u32;
-    let (top, chart_area) = cell.split_vertically(caption_h);
-    let width = rich_width(&top, &panel.title, caption)?;
-    let (w, _) = top.dim_in_pixel();
-    let left = ((w as i32 - width) / 2).max(0);
-    draw_rich(
-        &top,
-        &panel.title,
-        (left, (caption * 0.4).round() as i32),
-        caption,
-        &BLACK,
-    )?;
+    let chart_area = draw_caption(cell, &panel.title, style)?;
     let mut chart = ChartBuilder::on(&chart_area)
         .margin(style.len(10.0))
         .x_label_area_size(style.len(40.0 * style.font_size / 12.0))
@@ -913,45 +903,7 @@ fn draw_panel<DB: DrawingBackend>(
             .iter()
             .find(|en| en.dash.is_none() && en.label == s.label)
             .map_or(BLACK, |en| en.colour);
-        if let Some((lo, hi)) = &s.band {
-            let mut poly = decimate(&s.x, hi, Pick::Max);
-            poly.extend(decimate(&s.x, lo, Pick::Min).into_iter().rev());
-            chart
-                .draw_series(std::iter::once(Polygon::new(
-                    poly,
-                    colour.mix(0.18).filled(),
-                )))
-                .map_err(e)?;
-        }
-        let points = decimate(&s.x, &s.mean, Pick::Both);
-        match pen {
-            Pen::Stroke => {
-                chart
-                    .draw_series(LineSeries::new(points, colour.stroke_width(style.len(2.0))))
-                    .map_err(e)?;
-            }
-            Pen::Pixels => {
-                let (w, h) = chart.plotting_area().dim_in_pixel();
-                let dx = (x1 - x0) / f64::from(w.max(1));
-                let dy = (y1 - y0) / f64::from(h.max(1));
-                let thick = style.len(2.0) as i32 - 1;
-                let offsets = (0..=thick).flat_map(|i| {
-                    let i = f64::from(i);
-                    [(i * dx, 0.0), (0.0, i * dy)]
-                });
-                let mut seen = Vec::new();
-                for (ox, oy) in offsets {
-                    if seen.contains(&(ox, oy)) {
-                        continue;
-                    }
-                    seen.push((ox, oy));
-                    let shifted = points.iter().map(|&(x, y)| (x + ox, y + oy));
-                    chart
-                        .draw_series(LineSeries::new(shifted, colour.stroke_width(1)))
-                        .map_err(e)?;
-                }
-            }
-        }
+        draw_curve(&mut chart, s, colour, pen, style, (x1 - x0, y1 - y0))?;
     }
     for (label, y) in &panel.hlines {
         let Some(entry) = entries
@@ -969,6 +921,82 @@ fn draw_panel<DB: DrawingBackend>(
                 entry.colour.stroke_width(style.len(1.5)),
             ))
             .map_err(e)?;
+    }
+    Ok(())
+}
+
+/// Draws the caption `title` (with its subscripts) centred at the top of `cell`, and returns
+/// the area below it for the chart.
+fn draw_caption<DB: DrawingBackend>(
+    cell: &DrawingArea<DB, Shift>,
+    title: &str,
+    style: &Style,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    let caption = style.text(16.0);
+    let caption_h = (caption * 1.6).round() as u32;
+    let (top, chart_area) = cell.split_vertically(caption_h);
+    let width = rich_width(&top, title, caption)?;
+    let (w, _) = top.dim_in_pixel();
+    let left = ((w as i32 - width) / 2).max(0);
+    draw_rich(
+        &top,
+        title,
+        (left, (caption * 0.4).round() as i32),
+        caption,
+        &BLACK,
+    )?;
+    Ok(chart_area)
+}
+
+/// Draws the band and the mean of the series `s` in `colour` with `pen`; `spans` are the
+/// widths of the abscissa and ordinate ranges (the offsets of [`Pen::Pixels`] are pixels).
+fn draw_curve<DB: DrawingBackend>(
+    chart: &mut PanelChart<'_, DB>,
+    s: &Series,
+    colour: RGBColor,
+    pen: Pen,
+    style: &Style,
+    (x_span, y_span): (f64, f64),
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    if let Some((lo, hi)) = &s.band {
+        let mut poly = decimate(&s.x, hi, Pick::Max);
+        poly.extend(decimate(&s.x, lo, Pick::Min).into_iter().rev());
+        chart
+            .draw_series(std::iter::once(Polygon::new(
+                poly,
+                colour.mix(0.18).filled(),
+            )))
+            .map_err(e)?;
+    }
+    let points = decimate(&s.x, &s.mean, Pick::Both);
+    match pen {
+        Pen::Stroke => {
+            chart
+                .draw_series(LineSeries::new(points, colour.stroke_width(style.len(2.0))))
+                .map_err(e)?;
+        }
+        Pen::Pixels => {
+            let (w, h) = chart.plotting_area().dim_in_pixel();
+            let dx = x_span / f64::from(w.max(1));
+            let dy = y_span / f64::from(h.max(1));
+            let thick = style.len(2.0) as i32 - 1;
+            let offsets = (0..=thick).flat_map(|i| {
+                let i = f64::from(i);
+                [(i * dx, 0.0), (0.0, i * dy)]
+            });
+            let mut seen = Vec::new();
+            for (ox, oy) in offsets {
+                if seen.contains(&(ox, oy)) {
+                    continue;
+                }
+                seen.push((ox, oy));
+                let shifted = points.iter().map(|&(x, y)| (x + ox, y + oy));
+                chart
+                    .draw_series(LineSeries::new(shifted, colour.stroke_width(1)))
+                    .map_err(e)?;
+            }
+        }
     }
     Ok(())
 }

@@ -233,10 +233,10 @@ fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
         return Ok(None);
     }
     let text = fs::read_to_string(&path)
-        .map_err(|e| bad(dir, format!("cannot read {CHECKPOINT_FILE}: {e}")))?;
+        .map_err(|e| bad(dir, format!("cannot read {CHECKPOINT_FILE}: {e}")).with_source(e))?;
     serde_json::from_str(&text)
         .map(Some)
-        .map_err(|e| bad(dir, format!("{CHECKPOINT_FILE} is malformed: {e}")))
+        .map_err(|e| bad(dir, format!("{CHECKPOINT_FILE} is malformed: {e}")).with_source(e))
 }
 
 /// The bytes of the log and the run's progress: `log.csv` with its `summary.json`, or the
@@ -246,61 +246,82 @@ pub(crate) fn log_bytes(
     total: u64,
     dims: (usize, usize),
 ) -> Result<(Vec<u8>, Progress)> {
-    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
     let done = dir.join(LOG_FILE);
     if done.is_file() {
-        let bytes =
-            fs::read(&done).map_err(|e| bad(dir, format!("cannot read {LOG_FILE}: {e}")))?;
-        let path = dir.join(SUMMARY_FILE);
-        if !path.is_file() {
-            return Err(bad(
-                dir,
-                format!(
-                    "{LOG_FILE} without {SUMMARY_FILE}: the run did not finish writing its folder \
-                     (sepg run --resume {} completes it)",
-                    dir.display()
-                ),
-            ));
-        }
-        let text = fs::read_to_string(&path)
-            .map_err(|e| bad(dir, format!("cannot read {SUMMARY_FILE}: {e}")))?;
-        let s: Summary = serde_json::from_str(&text)
-            .map_err(|e| bad(dir, format!("{SUMMARY_FILE} is malformed: {e}")))?;
-        // a run stopped by a contradiction of its constants ends before its total
-        let stopped = s.status == "stopped"
-            && s.constants_check
-                .as_ref()
-                .is_some_and(ConstantsCheck::contradicted);
-        if s.iterations != total && !(stopped && s.iterations < total) {
-            return Err(bad(
-                dir,
-                format!(
-                    "{SUMMARY_FILE} reports {} iterations, the configuration {total}",
-                    s.iterations
-                ),
-            ));
-        }
-        let (v, w) = (s.final_params.v.clone(), s.final_params.w.clone());
-        if v.len() != dims.0 || w.len() != dims.1 || !finite(&v) || !finite(&w) {
-            return Err(bad(
-                dir,
-                format!("{SUMMARY_FILE}: the final parameters do not fit the run"),
-            ));
-        }
-        let progress = Progress {
-            done: s.iterations,
-            complete: true,
-            last: Params { v, w },
-            constants_check: s.constants_check.clone().unwrap_or_default(),
-            summary: Some(s),
-        };
-        return Ok((bytes, progress));
+        finished_log(dir, &done, total, dims)
+    } else {
+        partial_log(dir, total, dims)
     }
+}
+
+/// Whether every element of `xs` is finite.
+fn finite(xs: &[f64]) -> bool {
+    xs.iter().all(|x| x.is_finite())
+}
+
+/// The bytes of the finished log `done` and the progress its `summary.json` records.
+fn finished_log(
+    dir: &Path,
+    done: &Path,
+    total: u64,
+    dims: (usize, usize),
+) -> Result<(Vec<u8>, Progress)> {
+    let bytes = fs::read(done)
+        .map_err(|e| bad(dir, format!("cannot read {LOG_FILE}: {e}")).with_source(e))?;
+    let path = dir.join(SUMMARY_FILE);
+    if !path.is_file() {
+        return Err(bad(
+            dir,
+            format!(
+                "{LOG_FILE} without {SUMMARY_FILE}: the run did not finish writing its folder \
+                 (sepg run --resume {} completes it)",
+                dir.display()
+            ),
+        ));
+    }
+    let text = fs::read_to_string(&path)
+        .map_err(|e| bad(dir, format!("cannot read {SUMMARY_FILE}: {e}")).with_source(e))?;
+    let s: Summary = serde_json::from_str(&text)
+        .map_err(|e| bad(dir, format!("{SUMMARY_FILE} is malformed: {e}")).with_source(e))?;
+    // a run stopped by a contradiction of its constants ends before its total
+    let stopped = s.status == "stopped"
+        && s.constants_check
+            .as_ref()
+            .is_some_and(ConstantsCheck::contradicted);
+    if s.iterations != total && !(stopped && s.iterations < total) {
+        return Err(bad(
+            dir,
+            format!(
+                "{SUMMARY_FILE} reports {} iterations, the configuration {total}",
+                s.iterations
+            ),
+        ));
+    }
+    let (v, w) = (s.final_params.v.clone(), s.final_params.w.clone());
+    if v.len() != dims.0 || w.len() != dims.1 || !finite(&v) || !finite(&w) {
+        return Err(bad(
+            dir,
+            format!("{SUMMARY_FILE}: the final parameters do not fit the run"),
+        ));
+    }
+    let progress = Progress {
+        done: s.iterations,
+        complete: true,
+        last: Params { v, w },
+        constants_check: s.constants_check.clone().unwrap_or_default(),
+        summary: Some(s),
+    };
+    Ok((bytes, progress))
+}
+
+/// The checkpointed prefix of `log.partial.csv` and the progress its checkpoint records.
+fn partial_log(dir: &Path, total: u64, dims: (usize, usize)) -> Result<(Vec<u8>, Progress)> {
     let mut bytes = fs::read(dir.join(PARTIAL_LOG_FILE)).map_err(|e| {
         bad(
             dir,
             format!("no {LOG_FILE} and no readable {PARTIAL_LOG_FILE}: {e}"),
         )
+        .with_source(e)
     })?;
     let ck = read_checkpoint(dir)?.ok_or_else(|| {
         bad(

@@ -85,9 +85,9 @@ fn load(dir: &Path, file: &SweepFile) -> Result<Vec<Loaded>> {
         .map(|r| {
             let run_dir = dir.join(&r.dir);
             let text = std::fs::read_to_string(run_dir.join(SUMMARY_FILE))
-                .map_err(|e| Error::failed(format!("{}: {e}", run_dir.display())))?;
+                .map_err(|e| Error::failed_from(run_dir.display(), e))?;
             let summary: Summary = serde_json::from_str(&text)
-                .map_err(|e| Error::failed(format!("{}: {e}", run_dir.display())))?;
+                .map_err(|e| Error::failed_from(run_dir.display(), e))?;
             Ok(Loaded {
                 preset: r.preset,
                 variant: r.variant.clone(),
@@ -807,29 +807,8 @@ fn one_run(dir: &Path, x_axis: XAxis) -> Result<Figure> {
 /// The figure of a sweep folder, and the fewest seeds of any of its groups.
 fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(Figure, usize)> {
     let x_axis = opts.x_axis.unwrap_or(XAxis::Iteration);
-    let mut groups: Vec<(String, Vec<Log>)> = Vec::new();
-    let (mut done, mut total) = (0, 0);
-    let mut kinds = Vec::new();
-    for r in file.shard_runs() {
-        let run_dir = dir.join(&r.dir);
-        if !run_dir.join(CONFIG_FILE).is_file() {
-            continue;
-        }
-        let label = format!(
-            "{}, {}, σ⁰ = {}",
-            r.preset.name(),
-            display_name(&r.variant),
-            r.sigma0
-        );
-        let (log, check) = validated_log(&run_dir)?;
-        kinds.push(budget_kind(&run_dir)?);
-        done += check.iterations_done;
-        total += check.iterations_expected;
-        match groups.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, logs)) => logs.push(log),
-            None => groups.push((label, vec![log])),
-        }
-    }
+    let logs = SweepLogs::read(dir, file)?;
+    let groups = &logs.groups;
     if groups.is_empty() {
         return Err(Error::invalid(format!(
             "{} has no started run yet",
@@ -840,33 +819,16 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
     let panels = PANELS
         .iter()
         .map(|&(col, title, y)| {
-            let series = groups
-                .iter()
-                .filter_map(|(label, logs)| {
-                    let curves: Vec<Vec<f64>> = logs.iter().filter_map(|l| l.column(col)).collect();
-                    let x = logs
-                        .iter()
-                        .filter_map(|l| l.column(x_axis.column()))
-                        .min_by_key(Vec::len)?;
-                    let (mean, band) = mean_band_on(&curves, opts.band, scale_of(col));
-                    Some(Series {
-                        label: label.clone(),
-                        x: x[..mean.len().min(x.len())].to_vec(),
-                        mean,
-                        band,
-                    })
-                })
-                .collect();
             let title = match col {
                 "sigma" => format!("{title} (geometric mean)"),
-                "budget" => budget_title(title, &kinds),
+                "budget" => budget_title(title, &logs.kinds),
                 _ => title.to_owned(),
             };
             let panel = Panel {
                 title,
                 x_label: x_axis.label().into(),
                 y_label: y.into(),
-                series,
+                series: logs.series(col, x_axis, opts.band),
                 hlines: Vec::new(),
             };
             finish_panel(col, panel)
@@ -878,8 +840,8 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
         groups.len(),
         opts.band.describe()
     );
-    if done < total {
-        title.push_str(&format!(" ({})", incomplete_mark(done, total)));
+    if logs.done < logs.total {
+        title.push_str(&format!(" ({})", incomplete_mark(logs.done, logs.total)));
     }
     let fig = Figure {
         title,
@@ -887,6 +849,73 @@ fn sweep_figure(dir: &Path, file: &SweepFile, opts: &FigureOptions) -> Result<(F
         columns: 2,
     };
     Ok((fig, fewest))
+}
+
+/// The logs of the started runs of a sweep, grouped by (preset, variant, σ⁰).
+struct SweepLogs {
+    /// Each group's label and logs, in order of its first run.
+    groups: Vec<(String, Vec<Log>)>,
+    /// Iterations done by the started runs.
+    done: u64,
+    /// Iterations the started runs are to do.
+    total: u64,
+    /// The budget kind of each started run ([`budget_kind`]).
+    kinds: Vec<&'static str>,
+}
+
+impl SweepLogs {
+    /// Reads the validated log of every started run of the shard `file` of `dir`.
+    fn read(dir: &Path, file: &SweepFile) -> Result<Self> {
+        let mut logs = SweepLogs {
+            groups: Vec::new(),
+            done: 0,
+            total: 0,
+            kinds: Vec::new(),
+        };
+        for r in file.shard_runs() {
+            let run_dir = dir.join(&r.dir);
+            if !run_dir.join(CONFIG_FILE).is_file() {
+                continue;
+            }
+            let label = format!(
+                "{}, {}, σ⁰ = {}",
+                r.preset.name(),
+                display_name(&r.variant),
+                r.sigma0
+            );
+            let (log, check) = validated_log(&run_dir)?;
+            logs.kinds.push(budget_kind(&run_dir)?);
+            logs.done += check.iterations_done;
+            logs.total += check.iterations_expected;
+            match logs.groups.iter_mut().find(|(l, _)| *l == label) {
+                Some((_, group)) => group.push(log),
+                None => logs.groups.push((label, vec![log])),
+            }
+        }
+        Ok(logs)
+    }
+
+    /// One series per group of log column `col` against `x_axis`: the mean over the group's
+    /// runs and its band, up to the shortest abscissa (none for a group without the column).
+    fn series(&self, col: &str, x_axis: XAxis, band: BandKind) -> Vec<Series> {
+        self.groups
+            .iter()
+            .filter_map(|(label, logs)| {
+                let curves: Vec<Vec<f64>> = logs.iter().filter_map(|l| l.column(col)).collect();
+                let x = logs
+                    .iter()
+                    .filter_map(|l| l.column(x_axis.column()))
+                    .min_by_key(Vec::len)?;
+                let (mean, band) = mean_band_on(&curves, band, scale_of(col));
+                Some(Series {
+                    label: label.clone(),
+                    x: x[..mean.len().min(x.len())].to_vec(),
+                    mean,
+                    band,
+                })
+            })
+            .collect()
+    }
 }
 
 /// What `sepg plot` wrote, and what the reader of the figure should be warned about.

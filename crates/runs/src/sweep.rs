@@ -28,7 +28,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, audit, broken_runs_p_value};
+use crate::audit::{DEFAULT_ALPHA, DEFAULT_TOLERANCE, audit, broken_runs_p_value, check_levels};
 use crate::error::{Error, Result};
 use crate::folder::{CONFIG_FILE, check_out_dir, is_complete, to_json_line, write_atomic};
 use crate::run::{self, RunObserver, RunOptions, Silent};
@@ -144,10 +144,11 @@ impl SweepFile {
     /// [`Error::Invalid`] when the folder has no valid `sweep.json`.
     pub fn read(dir: &Path) -> Result<SweepFile> {
         let p = dir.join(SWEEP_FILE);
-        let text = std::fs::read_to_string(&p)
-            .map_err(|e| Error::invalid(format!("{} is not a sweep folder: {e}", dir.display())))?;
+        let text = std::fs::read_to_string(&p).map_err(|e| {
+            Error::invalid_from(format_args!("{} is not a sweep folder", dir.display()), e)
+        })?;
         serde_json::from_str(&text)
-            .map_err(|e| Error::invalid(format!("{} is invalid: {e}", p.display())))
+            .map_err(|e| Error::invalid_from(format_args!("{} is invalid", p.display()), e))
     }
 }
 
@@ -280,10 +281,10 @@ fn resolve_run(
         ..RunSpec::default()
     };
     base.overlay(variant).overlay(&axes).resolve().map_err(|e| {
-        Error::invalid(format!(
-            "variant {name} on {} with sigma0 {sigma0:?}: {e}",
-            preset.name()
-        ))
+        Error::invalid_from(
+            format_args!("variant {name} on {} with sigma0 {sigma0:?}", preset.name()),
+            e,
+        )
     })
 }
 
@@ -353,9 +354,10 @@ pub fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<Shard> {
 /// [`Error::Invalid`] for a missing file or an invalid key or value.
 pub fn read_spec(path: &Path) -> Result<SweepSpec> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
-    toml::from_str(&text)
-        .map_err(|e| Error::invalid(format!("{}: {}", path.display(), toml_message(&e))))
+        .map_err(|e| Error::invalid_from(format_args!("cannot read {}", path.display()), e))?;
+    toml::from_str(&text).map_err(|e| {
+        Error::invalid(format!("{}: {}", path.display(), toml_message(&e))).with_source(e)
+    })
 }
 
 /// Throughput of a finished sweep.
@@ -469,7 +471,7 @@ pub fn start(
 pub fn prepare(dir: &Path, file: &SweepFile, force: bool) -> Result<()> {
     check_out_dir(dir, force, &[SWEEP_FILE, RUNS_DIR, SUMMARY_CSV])?;
     std::fs::create_dir_all(dir)
-        .map_err(|e| Error::failed(format!("cannot create {}: {e}", dir.display())))?;
+        .map_err(|e| Error::failed_from(format_args!("cannot create {}", dir.display()), e))?;
     write_atomic(&dir.join(SWEEP_FILE), to_json_line(file)?.as_bytes())
 }
 
@@ -723,87 +725,18 @@ pub struct SweepAudit {
 /// [`Error::Invalid`] for a tolerance or level out of range; [`Error::Failed`] when a finished
 /// run's summary cannot be read or a file cannot be written.
 pub fn audit_sweep(dir: &Path, file: &SweepFile, tolerance: f64, alpha: f64) -> Result<SweepAudit> {
-    if !(tolerance.is_finite() && tolerance >= 0.0) {
-        return Err(Error::invalid(format!(
-            "--tolerance {tolerance} must be finite and >= 0"
-        )));
-    }
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(Error::invalid(format!("--alpha {alpha} must be in (0, 1)")));
-    }
+    check_levels(tolerance, alpha)?;
     let entries: Vec<&RunEntry> = file.shard_runs().collect();
     let runs: Vec<RunAudit> = entries
         .par_iter()
-        .map(|r| match audit(&dir.join(&r.dir), tolerance, alpha) {
-            Ok(a) => RunAudit {
-                dir: r.dir.clone(),
-                verdict: a.verdict.name().to_owned(),
-                failed: a.statement_failed(),
-                rate: a.null_rate(),
-            },
-            Err(e) => RunAudit {
-                dir: r.dir.clone(),
-                verdict: if e.is_invalid_input() {
-                    "malformed"
-                } else {
-                    "error"
-                }
-                .to_owned(),
-                failed: false,
-                rate: None,
-            },
-        })
+        .map(|r| audit_entry(dir, r, tolerance, alpha))
         .collect();
     let verdicts: Vec<String> = runs.iter().map(|r| r.verdict.clone()).collect();
     summary_csv(dir, file, &verdicts)?;
-    let mut keys: Vec<(EnvName, &str, u64)> = Vec::new();
-    let mut members: Vec<Vec<usize>> = Vec::new();
-    for (i, r) in entries.iter().enumerate() {
-        let k = (r.preset, r.variant.as_str(), r.sigma0.to_bits());
-        match keys.iter().position(|x| *x == k) {
-            Some(g) => members[g].push(i),
-            None => {
-                keys.push(k);
-                members.push(vec![i]);
-            }
-        }
-    }
     let mut groups = Vec::new();
-    for ((preset, variant, sigma0), idx) in keys.iter().zip(&members) {
+    for ((preset, variant, sigma0), idx) in audit_groups(&entries) {
         let of: Vec<&RunAudit> = idx.iter().map(|&i| &runs[i]).collect();
-        let n = of.len() as u64;
-        let failed = of.iter().filter(|r| r.failed).count() as u64;
-        let has = |v: &str| of.iter().any(|r| r.verdict == v);
-        let unfinished = ["incomplete", "malformed", "error"].iter().any(|v| has(v));
-        let rate = of
-            .iter()
-            .map(|r| r.rate)
-            .try_fold(0.0f64, |m, r| r.map(|r| m.max(r)));
-        let (verdict, p_value) = match rate {
-            _ if unfinished => (GroupVerdict::Incomplete, None),
-            Some(rate) => {
-                let p = broken_runs_p_value(failed, n, rate)?;
-                let v = if has("approximate") {
-                    GroupVerdict::Approximate
-                } else {
-                    GroupVerdict::Consistent
-                };
-                (v, Some(p))
-            }
-            None if has("not-checked") => (GroupVerdict::NotChecked, None),
-            None => (GroupVerdict::NoGuarantee, None),
-        };
-        groups.push(GroupAudit {
-            preset: preset.name().to_owned(),
-            variant: (*variant).to_owned(),
-            sigma0: f64::from_bits(*sigma0),
-            runs: n,
-            failed,
-            rate: rate.filter(|_| p_value.is_some()),
-            p_value,
-            level: None,
-            verdict,
-        });
+        groups.push(audit_group(preset, variant, f64::from_bits(sigma0), &of)?);
     }
     let tested = groups
         .iter()
@@ -819,9 +752,102 @@ pub fn audit_sweep(dir: &Path, file: &SweepFile, tolerance: f64, alpha: f64) -> 
             }
         }
     }
+    write_atomic(
+        &dir.join(AUDIT_GROUPS_CSV),
+        audit_groups_csv(&groups).as_bytes(),
+    )?;
+    Ok(SweepAudit { runs, groups })
+}
+
+/// The audit of the run `r` of the sweep folder `dir`: its verdict, or `malformed` (bad
+/// input) or `error` when it cannot be audited.
+fn audit_entry(dir: &Path, r: &RunEntry, tolerance: f64, alpha: f64) -> RunAudit {
+    match audit(&dir.join(&r.dir), tolerance, alpha) {
+        Ok(a) => RunAudit {
+            dir: r.dir.clone(),
+            verdict: a.verdict.name().to_owned(),
+            failed: a.statement_failed(),
+            rate: a.null_rate(),
+        },
+        Err(e) => RunAudit {
+            dir: r.dir.clone(),
+            verdict: if e.is_invalid_input() {
+                "malformed"
+            } else {
+                "error"
+            }
+            .to_owned(),
+            failed: false,
+            rate: None,
+        },
+    }
+}
+
+/// The key of a group of a sweep's audit: preset, variant and the bits of σ⁰.
+type GroupKey<'e> = (EnvName, &'e str, u64);
+
+/// The groups of `entries` in order of their first run, each with the indices of its runs.
+fn audit_groups<'e>(entries: &[&'e RunEntry]) -> Vec<(GroupKey<'e>, Vec<usize>)> {
+    let mut groups: Vec<(GroupKey<'_>, Vec<usize>)> = Vec::new();
+    for (i, r) in entries.iter().enumerate() {
+        let k = (r.preset, r.variant.as_str(), r.sigma0.to_bits());
+        match groups.iter_mut().find(|(x, _)| *x == k) {
+            Some((_, members)) => members.push(i),
+            None => groups.push((k, vec![i])),
+        }
+    }
+    groups
+}
+
+/// The audit of one group from the audits `of` its runs, before the Bonferroni level is set:
+/// incomplete when a run is unfinished or could not be audited, else tested by the exact
+/// binomial tail at the largest null rate of its runs when every run has one.
+fn audit_group(
+    preset: EnvName,
+    variant: &str,
+    sigma0: f64,
+    of: &[&RunAudit],
+) -> Result<GroupAudit> {
+    let n = of.len() as u64;
+    let failed = of.iter().filter(|r| r.failed).count() as u64;
+    let has = |v: &str| of.iter().any(|r| r.verdict == v);
+    let unfinished = ["incomplete", "malformed", "error"].iter().any(|v| has(v));
+    let rate = of
+        .iter()
+        .map(|r| r.rate)
+        .try_fold(0.0f64, |m, r| r.map(|r| m.max(r)));
+    let (verdict, p_value) = match rate {
+        _ if unfinished => (GroupVerdict::Incomplete, None),
+        Some(rate) => {
+            let p = broken_runs_p_value(failed, n, rate)?;
+            let v = if has("approximate") {
+                GroupVerdict::Approximate
+            } else {
+                GroupVerdict::Consistent
+            };
+            (v, Some(p))
+        }
+        None if has("not-checked") => (GroupVerdict::NotChecked, None),
+        None => (GroupVerdict::NoGuarantee, None),
+    };
+    Ok(GroupAudit {
+        preset: preset.name().to_owned(),
+        variant: variant.to_owned(),
+        sigma0,
+        runs: n,
+        failed,
+        rate: rate.filter(|_| p_value.is_some()),
+        p_value,
+        level: None,
+        verdict,
+    })
+}
+
+/// The text of [`AUDIT_GROUPS_CSV`]: its header and one line per group.
+fn audit_groups_csv(groups: &[GroupAudit]) -> String {
     let opt = |x: Option<f64>| x.map(|x| format!("{x:?}")).unwrap_or_default();
     let mut text = format!("{AUDIT_GROUPS_HEADER}\n");
-    for g in &groups {
+    for g in groups {
         text.push_str(&format!(
             "{},{},{:?},{},{},{},{},{},{}\n",
             g.preset,
@@ -835,8 +861,7 @@ pub fn audit_sweep(dir: &Path, file: &SweepFile, tolerance: f64, alpha: f64) -> 
             g.verdict.name()
         ));
     }
-    write_atomic(&dir.join(AUDIT_GROUPS_CSV), text.as_bytes())?;
-    Ok(SweepAudit { runs, groups })
+    text
 }
 
 #[cfg(test)]
@@ -885,7 +910,7 @@ mod tests {
     #[test]
     fn slurm_variables_that_do_not_give_a_shard_are_named() {
         let message = |vars: &[(&str, &str)]| match slurm(vars) {
-            Err(Error::Invalid(m)) => m,
+            Err(Error::Invalid(m)) => m.text().to_owned(),
             other => panic!("expected an invalid-input error, got {other:?}"),
         };
         let m = message(&[("SLURM_ARRAY_TASK_COUNT", "4")]);

@@ -191,6 +191,47 @@ impl ScalarJet {
     }
 }
 
+/// A first-order dual number `x + x' ε`: a value and its derivative in one parameter,
+/// propagated exactly by sums and products (the clipped DP carries `∂/∂v` with it).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Dual {
+    /// The value.
+    pub x: f64,
+    /// The derivative.
+    pub d: f64,
+}
+
+impl Dual {
+    /// A constant (derivative zero).
+    pub fn c(x: f64) -> Self {
+        Dual { x, d: 0.0 }
+    }
+
+    /// `self + o`.
+    pub fn add(self, o: Dual) -> Dual {
+        Dual {
+            x: self.x + o.x,
+            d: self.d + o.d,
+        }
+    }
+
+    /// `self · o` (product rule).
+    pub fn mul(self, o: Dual) -> Dual {
+        Dual {
+            x: self.x * o.x,
+            d: self.d * o.x + self.x * o.d,
+        }
+    }
+
+    /// `c · self` for a constant `c`.
+    pub fn scale(self, c: f64) -> Dual {
+        Dual {
+            x: self.x * c,
+            d: self.d * c,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,5 +270,13 @@ mod tests {
         assert_eq!(x.max_abs(), 15.0);
         let z = ScalarJet::zero(p).add(&s).scale(0.5);
         assert_eq!(z.val, 127.5);
+    }
+
+    #[test]
+    fn dual_numbers_differentiate_a_polynomial() {
+        // f(x) = 3 (x² + 2x) + 1 at x = 4: f = 73, f' = 3 (2x + 2) = 30.
+        let x = Dual { x: 4.0, d: 1.0 };
+        let f = x.mul(x).add(x.scale(2.0)).scale(3.0).add(Dual::c(1.0));
+        assert_eq!((f.x, f.d), (73.0, 30.0));
     }
 }

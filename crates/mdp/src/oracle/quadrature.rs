@@ -13,6 +13,66 @@
 //! It replaces `statrs::function::erf::erfc`, whose relative error reaches `1e-10` near
 //! `x = 0.5` (statrs 0.19.1), too large for the masses of the clipped DP.
 
+/// The `p` first-kind Chebyshev nodes on `[−1, 1]` and their barycentric weights: the
+/// interpolation of a function from its values at the nodes (Berrut & Trefethen, "Barycentric
+/// Lagrange interpolation", SIAM Review 46(3), 2004, eq. 5.3 with first-kind nodes).
+#[derive(Debug, Clone)]
+pub(crate) struct Chebyshev {
+    /// `cos((2j + 1)π / 2p)`, `j < p` (decreasing).
+    pub nodes: Vec<f64>,
+    /// `(−1)^j sin((2j + 1)π / 2p)`.
+    bary: Vec<f64>,
+}
+
+impl Chebyshev {
+    /// The rule with `p` nodes.
+    pub fn new(p: usize) -> Self {
+        let pf = p as f64;
+        let theta = |j: usize| std::f64::consts::PI * (2 * j + 1) as f64 / (2.0 * pf);
+        let nodes = (0..p).map(|j| theta(j).cos()).collect();
+        let bary = (0..p)
+            .map(|j| if j % 2 == 0 { 1.0 } else { -1.0 } * theta(j).sin())
+            .collect();
+        Chebyshev { nodes, bary }
+    }
+
+    /// The weights of the nodes at `t ∈ [−1, 1]` into `out[..p]` (barycentric formula; the
+    /// unit vector at a node): the interpolant at `t` is `Σ out[j] f(nodes[j])`.
+    pub fn weights(&self, t: f64, out: &mut [f64]) {
+        let p = self.nodes.len();
+        let mut total = 0.0;
+        for j in 0..p {
+            let d = t - self.nodes[j];
+            if d == 0.0 {
+                out[..p].iter_mut().for_each(|x| *x = 0.0);
+                out[j] = 1.0;
+                return;
+            }
+            out[j] = self.bary[j] / d;
+            total += out[j];
+        }
+        let inv = 1.0 / total;
+        out[..p].iter_mut().for_each(|x| *x *= inv);
+    }
+}
+
+/// `Σ a_i b_i` with four independent partial sums (a fixed order: deterministic).
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let (ca, ra) = a.as_chunks::<4>();
+    let (cb, rb) = b.as_chunks::<4>();
+    let (mut s0, mut s1, mut s2, mut s3) = (0.0, 0.0, 0.0, 0.0);
+    for (x, y) in ca.iter().zip(cb) {
+        s0 += x[0] * y[0];
+        s1 += x[1] * y[1];
+        s2 += x[2] * y[2];
+        s3 += x[3] * y[3];
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (s0 + s2) + (s1 + s3) + tail
+}
+
 /// `1/√(2π)`.
 const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
 
@@ -296,6 +356,24 @@ mod tests {
         assert!(erfc(f64::NAN).is_nan());
         assert_eq!(erfc(30.0), 0.0);
         assert_eq!(erfc(-30.0), 2.0);
+    }
+
+    #[test]
+    fn chebyshev_interpolation_reproduces_polynomials_below_its_degree() {
+        // f(x) = x³ − 2x + 0.5 (degree 3 < p = 6): the interpolant is f itself.
+        let f = |x: f64| x * x * x - 2.0 * x + 0.5;
+        let rule = Chebyshev::new(6);
+        let mut w = vec![0.0; 6];
+        for t in [-1.0, -0.7, 0.0, 0.3, 0.95, 1.0, rule.nodes[2]] {
+            rule.weights(t, &mut w);
+            let value: f64 = w.iter().zip(&rule.nodes).map(|(wj, x)| wj * f(*x)).sum();
+            assert!((value - f(t)).abs() < 1e-14, "t = {t}: {value} vs {}", f(t));
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+        }
+        // `dot` is Σ aᵢbᵢ whatever the length (a multiple of 4 or not).
+        let a: Vec<f64> = (1..=7).map(f64::from).collect();
+        assert_eq!(dot(&a, &a), 140.0);
+        assert_eq!(dot(&a[..4], &a[..4]), 30.0);
     }
 
     #[test]
