@@ -15,6 +15,7 @@
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 //! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
 //! | [`SepgOptions::constants`] | [`ConstantsFamily::Thesis`] (`sepg run`: tight) | [`ConstantsFamily::Thesis`] |
+//! | [`SepgOptions::batch`] | [`BatchRule::Fixed`] | [`BatchRule::Fixed`] |
 //!
 //! Serialised (the `options` of a run's `summary.json`), every choice is named in kebab-case as
 //! in `config.toml` (`"cross-fitted"`, `{"student-t": {"factor": 2.0}}`, `"theorem-4.9"`); the
@@ -148,6 +149,33 @@ impl Accounting {
     /// The bookkeeping of summaries written before the option existed.
     fn legacy() -> Self {
         Accounting::Estimated
+    }
+}
+
+/// How many trajectories each block of a sampled SEPG iteration draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BatchRule {
+    /// N trajectories per iteration, split evenly among its blocks (Algorithm 4.3).
+    #[default]
+    Fixed,
+    /// The adaptive batch size (docs/THEOREMS.md "An adaptive batch size"): the first
+    /// iteration splits N as [`BatchRule::Fixed`] does; every later block draws the n that
+    /// maximises the guaranteed improvement per trajectory of the greedy v-step, computed from
+    /// the previous iteration's v-block ([`crate::solver::batch::next_batch`]) and clamped to
+    /// `[n_min, n_max]` (trajectories per block).
+    Adaptive {
+        /// Smallest block size (≥ 2, for the Student-t widths).
+        n_min: usize,
+        /// Largest block size (≥ `n_min`).
+        n_max: usize,
+    },
+}
+
+impl BatchRule {
+    /// Whether the rule is [`BatchRule::Fixed`] (then omitted from summaries).
+    pub fn is_fixed(&self) -> bool {
+        *self == BatchRule::Fixed
     }
 }
 
@@ -363,6 +391,9 @@ pub struct SepgOptions {
     /// constants ([`crate::core::check`]): stop (the default) or continue without a guarantee.
     #[serde(default, skip_serializing_if = "OnContradiction::is_stop")]
     pub on_contradiction: OnContradiction,
+    /// How many trajectories each block draws (sampled SEPG with the certified accounting).
+    #[serde(default, skip_serializing_if = "BatchRule::is_fixed")]
+    pub batch: BatchRule,
 }
 
 impl Default for SepgOptions {
@@ -381,6 +412,7 @@ impl Default for SepgOptions {
             // The reward sign is read by the tight family only: two-sided is always sound.
             constants: LIBRARY_CONSTANTS.family(RewardSign::TwoSided),
             on_contradiction: OnContradiction::Stop,
+            batch: BatchRule::Fixed,
         }
     }
 }
@@ -412,9 +444,11 @@ impl SepgOptions {
     /// # Errors
     /// [`ConfigError::InvalidHyperParameter`] for a quantile factor that is not finite and
     /// positive, a clipping threshold that is not finite and positive, a reference batch
-    /// of 1 trajectory (a width needs 2), or Adam's hyper-parameters out of their domains;
+    /// of 1 trajectory (a width needs 2), Adam's hyper-parameters out of their domains, or an
+    /// adaptive batch rule with `n_min < 2` or `n_max < n_min`;
     /// [`ConfigError::UnsupportedOption`] for alternating iterations or the Adam v-direction
-    /// with the certified, resp. estimated, accounting.
+    /// with the certified, resp. estimated, accounting, and for the adaptive batch rule with
+    /// the estimated accounting.
     ///
     /// # Examples
     /// ```
@@ -446,6 +480,20 @@ impl SepgOptions {
         }
         if self.reference_batch == 1 {
             return Err(bad("reference batch", 1.0, "0 or at least 2"));
+        }
+        if let BatchRule::Adaptive { n_min, n_max } = self.batch {
+            if n_min < 2 {
+                return Err(bad("adaptive batch n_min", n_min as f64, "[2, n_max]"));
+            }
+            if n_max < n_min {
+                return Err(bad("adaptive batch n_max", n_max as f64, "[n_min, inf)"));
+            }
+            if self.accounting == Accounting::Estimated {
+                return Err(ConfigError::UnsupportedOption {
+                    option: "batch",
+                    reason: "the adaptive batch size needs the certified accounting",
+                });
+            }
         }
         if let VDirection::Adam {
             lr,

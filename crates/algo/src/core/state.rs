@@ -44,6 +44,11 @@ pub struct State {
     /// was checked, e.g. with exact gradients).
     #[serde(default, skip_serializing_if = "ConstantsCheck::is_empty")]
     pub constants_check: ConstantsCheck,
+    /// Trajectories per block of the next iteration, chosen by the adaptive batch rule
+    /// ([`BatchRule::Adaptive`](crate::core::options::BatchRule)) from the data of the
+    /// iterations so far; `None` before the first iteration and under the fixed rule.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub next_batch: Option<usize>,
 }
 
 impl State {
@@ -72,6 +77,7 @@ impl State {
             last_alpha: None,
             adam_v: None,
             constants_check: ConstantsCheck::default(),
+            next_batch: None,
         }
     }
 

@@ -21,6 +21,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub(crate) mod baseline;
+pub mod batch;
 pub(crate) mod exact;
 pub mod realise;
 pub mod sampled;

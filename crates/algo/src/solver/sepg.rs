@@ -2,7 +2,7 @@
 use crate::core::adam::AdamMoments;
 use crate::core::config::Requirement;
 use crate::core::error::RunError;
-use crate::core::options::{Accounting, Lb1Requirement, SepgOptions, VDirection};
+use crate::core::options::{Accounting, BatchRule, Lb1Requirement, SepgOptions, VDirection};
 use crate::core::record::Record;
 use crate::core::seed::Block;
 use crate::core::state::State;
@@ -12,6 +12,7 @@ use sepg_bounds::direction::{Direction, DirectionBound, FeatureNorm};
 use sepg_bounds::outcome::StepOutcome;
 use sepg_certified::Certified;
 
+use crate::solver::batch::next_batch;
 use crate::solver::realise::{CoordinateBound, DirectionalBound, realise, realise_along};
 use crate::solver::source::{BlockEstimate, Grad, GradientSource, Need, Query};
 use crate::solver::steps::{self, Plan};
@@ -806,9 +807,9 @@ fn iterate_certified(
     setup: &Setup,
     state: &mut State,
 ) -> Result<Record, RunError> {
-    let Setup { req, n, .. } = *setup;
+    let req = setup.req;
     let t = state.iteration;
-    let sizes = split(n, req.blocks());
+    let sizes = block_sizes(setup, state);
     let (mut trajectories, mut env_steps) = (state.trajectories, state.steps);
     // LB-I's surplus starts at 0 whatever B⁰ (its requirement is J ≥ J(θ⁰), Table 4.1); the
     // type-II budgets start at B⁰
@@ -860,6 +861,7 @@ fn iterate_certified(
     let b2 = add_down(b1, g_w);
 
     check_finite(&v_new, &w_new, t)?;
+    let batch = adapted_batch(setup, &ev, sizes[0])?;
     let mut row = Row::start(state, sigmas, ev.j, j_target, w_target);
     row.j_after_v = j_after_v;
     row.budget = b2;
@@ -869,7 +871,31 @@ fn iterate_certified(
     row.steps = env_steps;
     let record = record(row, v_log, w_log);
     advance(state, (v_new, w_new), b2, &record, alpha);
+    state.next_batch = batch;
     Ok(record)
+}
+
+/// The batch sizes of the blocks of the iteration `state` is at: all `state.next_batch` under
+/// [`BatchRule::Adaptive`] once chosen, otherwise N split evenly ([`split`]).
+fn block_sizes(setup: &Setup, state: &State) -> Vec<usize> {
+    match (setup.opts.batch, state.next_batch) {
+        (BatchRule::Adaptive { .. }, Some(m)) => vec![m; setup.req.blocks()],
+        _ => split(setup.n, setup.req.blocks()),
+    }
+}
+
+/// Under [`BatchRule::Adaptive`], the block size of the next iteration from this iteration's
+/// v-block estimate `ev` of `n_v` trajectories ([`next_batch`]); `None` under the fixed rule.
+fn adapted_batch(setup: &Setup, ev: &BlockEstimate, n_v: usize) -> Result<Option<usize>, RunError> {
+    let BatchRule::Adaptive { n_min, n_max } = setup.opts.batch else {
+        return Ok(None);
+    };
+    let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(
+        "the v-block returned no gradient".into(),
+    ))?;
+    next_batch(grad_v, n_v, n_min, n_max)
+        .map(Some)
+        .map_err(|e| RunError::Estimator(e.to_string()))
 }
 
 /// The allowances (v-step, w-step) of the certified accounting out of the budget `b0` at

@@ -1,4 +1,5 @@
 //! The test modules, grouped so that they compile into the single `lib` test binary.
+mod batch;
 mod certified;
 mod common;
 mod comparison;
