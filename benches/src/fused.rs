@@ -271,6 +271,8 @@ pub struct ZvIteration {
     sv: Vec<f64>,
     sw: Vec<f64>,
     dr: Vec<f64>,
+    /// The target block's returns.
+    returns: Vec<f64>,
     /// Suffix sums of the leave-one-out fits (`(rows + 1) × h`) and prefix sums (`h`).
     suf_n: Vec<f64>,
     suf_d: Vec<f64>,
@@ -349,6 +351,7 @@ impl ZvIteration {
             sv: Vec::new(),
             sw: Vec::new(),
             dr: Vec::new(),
+            returns: Vec::new(),
             suf_n: Vec::new(),
             suf_d: Vec::new(),
             pre_n: Vec::new(),
@@ -403,8 +406,8 @@ impl ZvIteration {
 
         // Target block: the deterministic policy's returns.
         let key = Block::Target.key(self.seed, t);
-        let returns = deterministic_returns(v, n_t, h, key);
-        let j_target = returns.iter().sum::<f64>() / n_t as f64;
+        deterministic_returns(v, n_t, h, key, &mut self.returns);
+        let j_target = self.returns.iter().sum::<f64>() / n_t as f64;
 
         // w-block at (vᵗ⁺¹, wᵗ): Ĵ and ∇̂_w J fused as above, the rows kept for ∇̂_w L.
         let required_w = -b1;
@@ -477,9 +480,15 @@ impl ZvIteration {
             scored::<false>(pol, n, h, key, none, &mut done);
         } else {
             for buf in [&mut self.sv, &mut self.sw, &mut self.dr] {
-                buf.resize(n * h, 0.0);
+                if buf.len() < n * h {
+                    buf.resize(n * h, 0.0);
+                }
             }
-            let rows = [&mut self.sv[..], &mut self.sw[..], &mut self.dr[..]];
+            let rows = [
+                &mut self.sv[..n * h],
+                &mut self.sw[..n * h],
+                &mut self.dr[..n * h],
+            ];
             scored::<true>(pol, n, h, key, rows, &mut done);
         }
         (j_sum * (1.0 / n as f64), x)
@@ -503,10 +512,10 @@ impl ZvIteration {
             pre_d: &mut self.pre_d,
         };
         fit.run(
-            n,
+            [s, dr],
             h,
-            |e| score_term(s[e], dr[e]),
-            |e, b| s[e] * (dr[e] - b),
+            |[s, f]| score_term(s, f),
+            |[s, f], b| s * (f - b),
             &mut self.g[..n],
         );
         let m = mean(&self.g[..n]);
@@ -542,26 +551,26 @@ impl ZvIteration {
             };
             // ∇̂_v J, optimal baseline: terms (S² F, S²), sample S (F − b).
             fit.run(
-                hi - lo,
+                [sv, dr],
                 h,
-                |e| score_term(sv[e], dr[e]),
-                |e, b| sv[e] * (dr[e] - b),
+                |[s, f]| score_term(s, f),
+                |[s, f], b| s * (f - b),
                 &mut self.g[lo..hi],
             );
             // ĥ with the baseline of Appendix B.2: u = G H F, z = G + H, H = S^w/σ.
-            let uz = |e: usize| {
-                let hj = sw[e] / sigma;
-                (sv[e] * hj * dr[e], sv[e] + hj)
+            let uz = |[g, w, f]: [f64; 3]| {
+                let hj = w / sigma;
+                (g * hj * f, g + hj)
             };
             fit.run(
-                hi - lo,
+                [sv, sw, dr],
                 h,
-                |e| {
-                    let (u, z) = uz(e);
+                |x| {
+                    let (u, z) = uz(x);
                     (u * z, z * z)
                 },
-                |e, b| {
-                    let (u, z) = uz(e);
+                |x, b| {
+                    let (u, z) = uz(x);
                     u - b * z
                 },
                 &mut self.d[lo..hi],
@@ -628,44 +637,60 @@ struct Loo<'a> {
 }
 
 impl Loo<'_> {
-    fn run(
+    /// The fit on the rows of `inputs` (`out.len()` rows of `h` entries each): `term` gives
+    /// an entry's `(num, den)`, `sample` its sample term with the baseline.
+    #[inline(always)]
+    fn run<const K: usize>(
         &mut self,
-        rows: usize,
+        inputs: [&[f64]; K],
         h: usize,
-        term: impl Fn(usize) -> (f64, f64),
-        sample: impl Fn(usize, f64) -> f64,
+        term: impl Fn([f64; K]) -> (f64, f64),
+        sample: impl Fn([f64; K], f64) -> f64,
         out: &mut [f64],
     ) {
+        let rows = out.len();
         let used = (rows + 1) * h;
         for buf in [&mut *self.suf_n, &mut *self.suf_d] {
-            buf.clear();
-            buf.resize(used, 0.0);
+            if buf.len() < used {
+                buf.resize(used, 0.0);
+            }
+            buf[rows * h..used].fill(0.0);
         }
+        let row = |r: usize| -> [&[f64]; K] { std::array::from_fn(|k| &inputs[k][r * h..][..h]) };
         for r in (0..rows).rev() {
+            let x = row(r);
+            let (sn, sn_next) = self.suf_n[r * h..(r + 2) * h].split_at_mut(h);
+            let (sd, sd_next) = self.suf_d[r * h..(r + 2) * h].split_at_mut(h);
             for t in 0..h {
-                let (n, d) = term(r * h + t);
-                self.suf_n[r * h + t] = self.suf_n[(r + 1) * h + t] + n;
-                self.suf_d[r * h + t] = self.suf_d[(r + 1) * h + t] + d;
+                let (n, d) = term(std::array::from_fn(|k| x[k][t]));
+                sn[t] = sn_next[t] + n;
+                sd[t] = sd_next[t] + d;
             }
         }
         for buf in [&mut *self.pre_n, &mut *self.pre_d] {
             buf.clear();
             buf.resize(h, 0.0);
         }
-        for (r, x) in out.iter_mut().enumerate() {
+        let (pre_n, pre_d) = (&mut self.pre_n[..h], &mut self.pre_d[..h]);
+        for (r, x_out) in out.iter_mut().enumerate() {
+            let x = row(r);
+            let (on, od) = (
+                &self.suf_n[(r + 1) * h..][..h],
+                &self.suf_d[(r + 1) * h..][..h],
+            );
             let mut acc = 0.0;
             for t in 0..h {
-                let e = r * h + t;
-                let num = self.pre_n[t] + self.suf_n[e + h];
-                let den = self.pre_d[t] + self.suf_d[e + h];
+                let v = std::array::from_fn(|k| x[k][t]);
+                let num = pre_n[t] + on[t];
+                let den = pre_d[t] + od[t];
                 let q = num / den;
                 let b = if den > 0.0 { q } else { 0.0 };
-                let (n, d) = term(e);
-                self.pre_n[t] += n;
-                self.pre_d[t] += d;
-                acc += sample(e, b);
+                let (n, d) = term(v);
+                pre_n[t] += n;
+                pre_d[t] += d;
+                acc += sample(v, b);
             }
-            *x = acc;
+            *x_out = acc;
         }
     }
 }
@@ -807,23 +832,40 @@ fn scored_lanes<const K: usize, const KEEP: bool>(
 }
 
 /// The discounted returns of `n` `lqg1d` trajectories of `h` steps of the deterministic
-/// policy `a = v s` drawn from `key` (summed from 0 in the order of `t`).
-fn deterministic_returns(v: f64, n: usize, h: usize, key: SeedKey) -> Vec<f64> {
+/// policy `a = v s` drawn from `key` (summed from 0 in the order of `t`), four in lockstep.
+fn deterministic_returns(v: f64, n: usize, h: usize, key: SeedKey, out: &mut Vec<f64>) {
+    out.clear();
+    let mut first = 0;
+    while first < n {
+        if first + 4 <= n {
+            out.extend(deterministic_lanes::<4>(v, first, h, key));
+            first += 4;
+        } else {
+            out.extend(deterministic_lanes::<1>(v, first, h, key));
+            first += 1;
+        }
+    }
+}
+
+/// Trajectories `first .. first + K` of [`deterministic_returns`] in lockstep.
+#[inline(always)]
+fn deterministic_lanes<const K: usize>(v: f64, first: usize, h: usize, key: SeedKey) -> [f64; K] {
     let (a_, b_, q, r, lim, gamma) = LQG1D;
-    (0..n)
-        .map(|i| {
-            let mut rng = key.rngs(i as u64);
-            let mut s = uniform(&mut rng.env, -lim, lim);
-            let (mut ret, mut disc) = (0.0, 1.0);
-            for _ in 0..h {
-                let ac = clip(v * s, -lim, lim);
-                ret += disc * -(s * (q * s) + ac * (r * ac));
-                s = clip(a_ * s + b_ * ac, -lim, lim);
-                disc *= gamma;
-            }
-            ret
-        })
-        .collect()
+    let mut s: [f64; K] = std::array::from_fn(|k| {
+        let mut rngs = key.rngs((first + k) as u64);
+        uniform(&mut rngs.env, -lim, lim)
+    });
+    let (mut ret, mut disc) = ([0.0; K], 1.0);
+    for _ in 0..h {
+        for k in 0..K {
+            let sk = s[k];
+            let ac = clip(v * sk, -lim, lim);
+            ret[k] += disc * -(sk * (q * sk) + ac * (r * ac));
+            s[k] = clip(a_ * sk + b_ * ac, -lim, lim);
+        }
+        disc *= gamma;
+    }
+    ret
 }
 
 /// `x` clipped to `[lo, hi]` (`lo ≤ hi`), as the engine's kernels clip.
