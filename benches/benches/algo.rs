@@ -1,8 +1,9 @@
 //! One sampled SEPG-ZV iteration on `lqg1d` with N = 100, H = 20 (three blocks: v, target, w),
-//! and, in the same run, its reference: the fused loop (`sepg_benches::fused::lqg1d`) over the
-//! same number of environment steps (100 trajectories of 20 steps at σ = 1 with their
-//! G(PO)MDP sums). Report the ratio reference ÷ iteration: the share of the iteration's time
-//! that the fused rollouts of its trajectories would take.
+//! and, in the same run, its two references: the fused loop (`sepg_benches::fused::lqg1d`)
+//! over the same number of environment steps (100 trajectories of 20 steps at σ = 1 with their
+//! G(PO)MDP sums), and the whole-iteration reference (`sepg_benches::fused::ZvIteration`: the
+//! same iteration, the same bits, written as plain loops). Report the ratios iteration ÷
+//! reference.
 //!
 //! Single-threaded figure: `RAYON_NUM_THREADS=1 cargo bench -p sepg-benches --bench algo`.
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -36,6 +37,16 @@ fn sepg_zv_iteration(c: &mut Criterion) {
                 let key = SeedKey::new(1, it, 0);
                 black_box(fused::lqg1d(-0.1, 1.0, 100, 20, key, &zeros, &zeros))
             })
+        })
+    });
+    group.bench_function("whole_iteration_reference", |b| {
+        let mut fused = fused::ZvIteration::new(&checked).expect("supported configuration");
+        let mut state = start.clone();
+        b.iter(|| {
+            if state.iteration >= 1000 {
+                state = start.clone();
+            }
+            fused.iterate(&mut state).expect("iteration")
         })
     });
     group.bench_function("iteration", |b| {

@@ -436,8 +436,10 @@ impl Estimator {
     }
 
     /// Runs one estimator on the trajectories `rows`, writing `rows.len() × comps` samples
-    /// (see [`crate::kernel`]; every baseline is fitted on `rows` only). A constant baseline
-    /// is applied by running the estimator without baseline on the shifted rewards
+    /// (see [`crate::kernel`]; every baseline is fitted on `rows` only). G(PO)MDP with a
+    /// constant baseline is summed in one pass ([`gpomdp_constant`]); for the other
+    /// estimators a constant baseline is applied by running the estimator without baseline on
+    /// the shifted rewards
     /// `γ^t (r_t − b)`.
     pub(crate) fn kernel(
         &mut self,
@@ -450,6 +452,22 @@ impl Estimator {
     ) {
         let h = batch.horizon;
         let nr = rows.len();
+        if let (Target::Gpomdp(p), Baseline::Constant(b)) = (target, baseline) {
+            let (s, comps) = match p {
+                Param::V => (&batch.cum_score_v, batch.dim_v),
+                Param::W => (&batch.cum_score_w, batch.dim_w),
+            };
+            let s = &s[rows.start * h * comps..rows.end * h * comps];
+            let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
+            gpomdp_constant(
+                s,
+                comps,
+                rewards,
+                (h, batch.gamma, b),
+                &mut out[..nr * comps],
+            );
+            return;
+        }
         let mut shifted = std::mem::take(&mut self.shifted);
         let rewards = &batch.disc_rewards[rows.start * h..rows.end * h];
         let (rewards, baseline) = match baseline {
@@ -700,6 +718,43 @@ fn shift_rewards(shifted: &mut Vec<f64>, rewards: &[f64], h: usize, gamma: f64, 
         for f in row {
             *f -= discount * b;
             discount *= gamma;
+        }
+    }
+}
+
+/// G(PO)MDP with the constant baseline `b` in one pass over each trajectory's rows:
+/// `x_{r,c} = Σ_t S_{r,t,c} (F_{r,t} − γ^t b)`, summed from 0 in the order of `t`, with
+/// `γ^t` the running product and `F − γ^t b` rounded as [`shift_rewards`] rounds it, so the
+/// samples are those of the estimator without baseline on the shifted rewards, bit for bit,
+/// without the shifted copy and the stored sample terms.
+fn gpomdp_constant(
+    s: &[f64],
+    comps: usize,
+    rewards: &[f64],
+    (h, gamma, b): (usize, f64, f64),
+    out: &mut [f64],
+) {
+    let rows = s.chunks_exact(h * comps).zip(rewards.chunks_exact(h));
+    if comps == 1 {
+        for (x, (s, f)) in out.iter_mut().zip(rows) {
+            let (mut acc, mut discount) = (0.0, 1.0);
+            for (s, f) in s.iter().zip(f) {
+                acc += s * (f - discount * b);
+                discount *= gamma;
+            }
+            *x = acc;
+        }
+        return;
+    }
+    for (x, (s, f)) in out.chunks_exact_mut(comps).zip(rows) {
+        x.fill(0.0);
+        let mut discount = 1.0;
+        for (st, f) in s.chunks_exact(comps).zip(f) {
+            let f = f - discount * b;
+            discount *= gamma;
+            for (xc, sc) in x.iter_mut().zip(st) {
+                *xc += sc * f;
+            }
         }
     }
 }
