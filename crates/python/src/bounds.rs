@@ -845,7 +845,7 @@ impl From<Certified> for PyCertified {
 #[pymethods]
 impl PyCertified {
     /// `"certified"`, `"infeasible"`, `"uncertifiable"`, `"zero_gradient"` or `"below_noise"`:
-    /// a certified step has the label of `sepg bounds --certified` and of [`bounds_report`].
+    /// a certified step has the label of `sepg bounds --certified` and of `bounds_report`.
     #[getter]
     fn kind(&self) -> &'static str {
         match self.0 {

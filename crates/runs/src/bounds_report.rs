@@ -825,19 +825,28 @@ mod tests {
             horizon: Some(Horizon::Finite(20)),
             ..query()
         };
-        let r = report(&q, false).unwrap();
-        let json = serde_json::to_value(&r).unwrap();
-        let rows = r.rows();
-        assert_eq!(rows.len(), 26);
-        for row in rows {
-            let value = &json[row.name];
-            match row.value {
-                RowValue::Real(x) | RowValue::Constant(x) | RowValue::Exact(x) => {
-                    assert_eq!(value.as_f64(), Some(x), "{}", row.name)
+        let tight = BoundsQuery {
+            constants: ConstantsName::Tight,
+            rewards: Some(RewardsName::NonPositive),
+            ..q.clone()
+        };
+        // 9 rows of σ, 13 of the gradients and batch sizes, 4 of counts and answers; the
+        // tight family adds its horizon, reward sign, S_H and ρ
+        for (q, count) in [(q, 26), (tight, 30)] {
+            let r = report(&q, false).unwrap();
+            let json = serde_json::to_value(&r).unwrap();
+            let rows = r.rows();
+            assert_eq!(rows.len(), count);
+            for row in rows {
+                let (value, name) = (&json[row.name], row.name);
+                match row.value {
+                    RowValue::Real(x) | RowValue::Constant(x) | RowValue::Exact(x) => {
+                        assert_eq!(value.as_f64(), Some(x), "{name}")
+                    }
+                    RowValue::Count(n) => assert_eq!(value.as_u64(), Some(n), "{name}"),
+                    RowValue::Flag(b) => assert_eq!(value.as_bool(), Some(b), "{name}"),
+                    RowValue::Name(s) => assert_eq!(value.as_str(), Some(s.as_str()), "{name}"),
                 }
-                RowValue::Count(n) => assert_eq!(value.as_u64(), Some(n), "{}", row.name),
-                RowValue::Flag(b) => assert_eq!(value.as_bool(), Some(b), "{}", row.name),
-                RowValue::Name(s) => assert_eq!(value.as_str(), Some(s.as_str()), "{}", row.name),
             }
         }
     }
