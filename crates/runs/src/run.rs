@@ -165,13 +165,15 @@ pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
         return Ok(summary);
     }
     let ck_path = dir.join(CHECKPOINT_FILE);
-    let text = fs::read_to_string(&ck_path)
-        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", ck_path.display())))?;
+    let text = fs::read_to_string(&ck_path).map_err(|e| {
+        Error::invalid(format!("cannot read {}: {e}", ck_path.display())).with_source(e)
+    })?;
     let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| {
         Error::invalid(format!(
             "{} is not a valid checkpoint: {e}",
             ck_path.display()
         ))
+        .with_source(e)
     })?;
     let partial = dir.join(PARTIAL_LOG_FILE);
     let finished = dir.join(LOG_FILE);
@@ -186,10 +188,9 @@ pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
 
 /// Cuts the partial log back to the `log_bytes` its checkpoint vouches for.
 fn truncate_log(partial: &Path, log_bytes: u64) -> Result<()> {
-    let file = OpenOptions::new()
-        .write(true)
-        .open(partial)
-        .map_err(|e| Error::invalid(format!("cannot open {}: {e}", partial.display())))?;
+    let file = OpenOptions::new().write(true).open(partial).map_err(|e| {
+        Error::invalid(format!("cannot open {}: {e}", partial.display())).with_source(e)
+    })?;
     let len = file
         .metadata()
         .map_err(|e| io_fail("read", partial, e))?
@@ -289,7 +290,7 @@ fn preflight(resolved: &Resolved) -> Result<Option<First>> {
         Error::invalid(format!("the run cannot start from its initial policy: {e}"))
     };
     let mut solver = PolicySolver::new(&resolved.checked)
-        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")).with_source(e))?;
     if resolved.iterations() == 0 {
         return Ok(None);
     }
@@ -315,7 +316,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     let every = resolved.log_every();
     let mut writer = Writer::open(dir, ck)?;
     let mut solver = PolicySolver::new(&resolved.checked)
-        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")))?;
+        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")).with_source(e))?;
     let mut state = writer.ck.state.clone();
     if state.iteration == 0
         && let Err(e) = solver.init(&mut state)
@@ -358,7 +359,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
                     dir.display(),
                     before.iteration,
                     before.iteration
-                )));
+                )).with_source(e));
             }
         };
         tally.add(&record);
