@@ -115,12 +115,28 @@ fn run(
             *m = ((*m as f64 * scale).round() as usize).clamp(n_min, n_max);
         }
     }
+    let final_point = (state.v[0], state.w[0]);
+    let (v_steps, steps_checked, violations) = audit(&records, final_point, exact);
+    Outcome {
+        trajectories: state.trajectories,
+        error: (state.v[0] - v_star).abs(),
+        sigma: state.w[0].exp(),
+        v_steps,
+        steps_checked,
+        violations,
+        last_block,
+    }
+}
+
+/// The v-steps of a run's `records` (ending at `final_point`), the steps with a change that were
+/// checked against exact J, and the exact violations among them.
+fn audit(records: &[Record], final_point: (f64, f64), exact: &mut Exact) -> (usize, usize, usize) {
     let (mut v_steps, mut steps_checked, mut violations) = (0, 0, 0);
-    for r in &records {
+    for r in records {
         let (v0, w0) = (r.v[0], r.w[0]);
         let next = records
             .get(r.iteration as usize + 1)
-            .map_or((state.v[0], state.w[0]), |n| (n.v[0], n.w[0]));
+            .map_or(final_point, |n| (n.v[0], n.w[0]));
         v_steps += usize::from(next.0 != v0);
         // the v-step (vᵗ, wᵗ) → (vᵗ⁺¹, wᵗ), then the w-step → (vᵗ⁺¹, wᵗ⁺¹), each against its
         // logged guarantee (0 when no change was made)
@@ -139,15 +155,7 @@ fn run(
             }
         }
     }
-    Outcome {
-        trajectories: state.trajectories,
-        error: (state.v[0] - v_star).abs(),
-        sigma: state.w[0].exp(),
-        v_steps,
-        steps_checked,
-        violations,
-        last_block,
-    }
+    (v_steps, steps_checked, violations)
 }
 
 fn main() {
