@@ -64,10 +64,13 @@ struct Outcome {
     last_block: usize,
 }
 
+/// One run of `req` from σ⁰ = `sigma0` under the rule `batch`; with the adaptive rule, every
+/// block size it chooses is multiplied by `scale` (then clamped to the rule's range again), which
+/// turns Proposition B's n* = 4b̂²/ĝ² into scale·4b̂²/ĝ² (docs/THEOREMS.md, "Which step").
 fn run(
     req: Requirement,
     sigma0: f64,
-    batch: BatchRule,
+    (batch, scale): (BatchRule, f64),
     seed: u64,
     exact: &mut Exact,
     v_star: f64,
@@ -80,10 +83,11 @@ fn run(
     cfg.options.constants = ConstantsFamily::Tight {
         rewards: reward_sign(&env),
     };
-    cfg.options.batch = batch;
     let checked = cfg.check().expect("valid configuration");
     let mut state = checked.initial_state();
-    let mut solver = PolicySolver::new(&checked).expect("solver");
+    let mut solver = PolicySolver::new(&checked)
+        .and_then(|s| s.with_batch_rule(batch))
+        .expect("solver");
     solver.init(&mut state).expect("init");
     let blocks = req.blocks() as u64;
     let mut records: Vec<Record> = Vec::new();
@@ -106,13 +110,33 @@ fn run(
         }
         last_block = (next / blocks) as usize;
         records.push(solver.next_iter(&mut state).expect("iteration"));
+        if let (Some(m), BatchRule::Adaptive { n_min, n_max }) = (state.next_batch.as_mut(), batch)
+        {
+            *m = ((*m as f64 * scale).round() as usize).clamp(n_min, n_max);
+        }
     }
+    let final_point = (state.v[0], state.w[0]);
+    let (v_steps, steps_checked, violations) = audit(&records, final_point, exact);
+    Outcome {
+        trajectories: state.trajectories,
+        error: (state.v[0] - v_star).abs(),
+        sigma: state.w[0].exp(),
+        v_steps,
+        steps_checked,
+        violations,
+        last_block,
+    }
+}
+
+/// The v-steps of a run's `records` (ending at `final_point`), the steps with a change that were
+/// checked against exact J, and the exact violations among them.
+fn audit(records: &[Record], final_point: (f64, f64), exact: &mut Exact) -> (usize, usize, usize) {
     let (mut v_steps, mut steps_checked, mut violations) = (0, 0, 0);
-    for r in &records {
+    for r in records {
         let (v0, w0) = (r.v[0], r.w[0]);
         let next = records
             .get(r.iteration as usize + 1)
-            .map_or((state.v[0], state.w[0]), |n| (n.v[0], n.w[0]));
+            .map_or(final_point, |n| (n.v[0], n.w[0]));
         v_steps += usize::from(next.0 != v0);
         // the v-step (vᵗ, wᵗ) → (vᵗ⁺¹, wᵗ), then the w-step → (vᵗ⁺¹, wᵗ⁺¹), each against its
         // logged guarantee (0 when no change was made)
@@ -131,15 +155,7 @@ fn run(
             }
         }
     }
-    Outcome {
-        trajectories: state.trajectories,
-        error: (state.v[0] - v_star).abs(),
-        sigma: state.w[0].exp(),
-        v_steps,
-        steps_checked,
-        violations,
-        last_block,
-    }
+    (v_steps, steps_checked, violations)
 }
 
 fn main() {
@@ -169,11 +185,17 @@ fn main() {
     for sigma0 in [1.0, 0.5] {
         for (name, req) in [("MI", Requirement::Mi), ("ZV", Requirement::Zv)] {
             let n_max = (BUDGET / req.blocks() as u64 / 2) as usize;
+            let adaptive = BatchRule::Adaptive { n_min: 50, n_max };
             for (label, rule) in [
-                ("fixed N = 100".to_owned(), BatchRule::Fixed),
+                ("fixed N = 100".to_owned(), (BatchRule::Fixed, 1.0)),
+                (format!("adaptive 4b²/g², [50, {n_max}]"), (adaptive, 1.0)),
                 (
-                    format!("adaptive [50, {n_max}]"),
-                    BatchRule::Adaptive { n_min: 50, n_max },
+                    format!("adaptive (3+2√2)b²/g², [50, {n_max}]"),
+                    (adaptive, (3.0 + 2.0 * 2f64.sqrt()) / 4.0),
+                ),
+                (
+                    format!("adaptive (13+3√17)/2·b²/g², [50, {n_max}]"),
+                    (adaptive, (13.0 + 3.0 * 17f64.sqrt()) / 8.0),
                 ),
             ] {
                 let outs: Vec<Outcome> = (0..seeds)

@@ -15,7 +15,6 @@
 //! | [`SepgOptions::schedule`] | [`Schedule::Run`] | [`Schedule::Iteration`] |
 //! | [`SepgOptions::v_direction`] | [`VDirection::Greedy`] | [`VDirection::Greedy`] |
 //! | [`SepgOptions::constants`] | [`ConstantsFamily::Thesis`] (`sepg run`: tight) | [`ConstantsFamily::Thesis`] |
-//! | [`SepgOptions::batch`] | [`BatchRule::Fixed`] | [`BatchRule::Fixed`] |
 //!
 //! Serialised (the `options` of a run's `summary.json`), every choice is named in kebab-case as
 //! in `config.toml` (`"cross-fitted"`, `{"student-t": {"factor": 2.0}}`, `"theorem-4.9"`); the
@@ -152,7 +151,8 @@ impl Accounting {
     }
 }
 
-/// How many trajectories each block of a sampled SEPG iteration draws.
+/// How many trajectories each block of a sampled SEPG iteration draws, set on a solver with
+/// [`PolicySolver::with_batch_rule`](crate::solver::PolicySolver::with_batch_rule).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BatchRule {
@@ -173,9 +173,53 @@ pub enum BatchRule {
 }
 
 impl BatchRule {
-    /// Whether the rule is [`BatchRule::Fixed`] (then omitted from summaries).
+    /// Whether the rule is [`BatchRule::Fixed`].
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::BatchRule;
+    /// assert!(BatchRule::default().is_fixed());
+    /// ```
     pub fn is_fixed(&self) -> bool {
         *self == BatchRule::Fixed
+    }
+
+    /// Checks the rule for a solver with the given `accounting`.
+    ///
+    /// # Errors
+    /// [`ConfigError::InvalidHyperParameter`] for an adaptive rule with `n_min < 2` or
+    /// `n_max < n_min`; [`ConfigError::UnsupportedOption`] for an adaptive rule with the
+    /// estimated accounting (only the certified iteration reads the rule).
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::options::{Accounting, BatchRule};
+    /// let rule = BatchRule::Adaptive { n_min: 50, n_max: 250_000 };
+    /// assert!(rule.validate(Accounting::Certified).is_ok());
+    /// assert!(rule.validate(Accounting::Estimated).is_err());
+    /// ```
+    pub fn validate(&self, accounting: Accounting) -> Result<(), ConfigError> {
+        let BatchRule::Adaptive { n_min, n_max } = *self else {
+            return Ok(());
+        };
+        let bad = |name, value: usize, domain| ConfigError::InvalidHyperParameter {
+            name,
+            value: value as f64,
+            domain,
+        };
+        if n_min < 2 {
+            return Err(bad("adaptive batch n_min", n_min, "[2, n_max]"));
+        }
+        if n_max < n_min {
+            return Err(bad("adaptive batch n_max", n_max, "[n_min, inf)"));
+        }
+        if accounting == Accounting::Estimated {
+            return Err(ConfigError::UnsupportedOption {
+                option: "batch",
+                reason: "the adaptive batch size needs the certified accounting",
+            });
+        }
+        Ok(())
     }
 }
 
@@ -391,9 +435,6 @@ pub struct SepgOptions {
     /// constants ([`crate::core::check`]): stop (the default) or continue without a guarantee.
     #[serde(default, skip_serializing_if = "OnContradiction::is_stop")]
     pub on_contradiction: OnContradiction,
-    /// How many trajectories each block draws (sampled SEPG with the certified accounting).
-    #[serde(default, skip_serializing_if = "BatchRule::is_fixed")]
-    pub batch: BatchRule,
 }
 
 impl Default for SepgOptions {
@@ -412,7 +453,6 @@ impl Default for SepgOptions {
             // The reward sign is read by the tight family only: two-sided is always sound.
             constants: LIBRARY_CONSTANTS.family(RewardSign::TwoSided),
             on_contradiction: OnContradiction::Stop,
-            batch: BatchRule::Fixed,
         }
     }
 }
@@ -444,11 +484,9 @@ impl SepgOptions {
     /// # Errors
     /// [`ConfigError::InvalidHyperParameter`] for a quantile factor that is not finite and
     /// positive, a clipping threshold that is not finite and positive, a reference batch
-    /// of 1 trajectory (a width needs 2), Adam's hyper-parameters out of their domains, or an
-    /// adaptive batch rule with `n_min < 2` or `n_max < n_min`;
+    /// of 1 trajectory (a width needs 2), or Adam's hyper-parameters out of their domains;
     /// [`ConfigError::UnsupportedOption`] for alternating iterations or the Adam v-direction
-    /// with the certified, resp. estimated, accounting, and for the adaptive batch rule with
-    /// the estimated accounting.
+    /// with the certified, resp. estimated, accounting.
     ///
     /// # Examples
     /// ```
@@ -480,20 +518,6 @@ impl SepgOptions {
         }
         if self.reference_batch == 1 {
             return Err(bad("reference batch", 1.0, "0 or at least 2"));
-        }
-        if let BatchRule::Adaptive { n_min, n_max } = self.batch {
-            if n_min < 2 {
-                return Err(bad("adaptive batch n_min", n_min as f64, "[2, n_max]"));
-            }
-            if n_max < n_min {
-                return Err(bad("adaptive batch n_max", n_max as f64, "[n_min, inf)"));
-            }
-            if self.accounting == Accounting::Estimated {
-                return Err(ConfigError::UnsupportedOption {
-                    option: "batch",
-                    reason: "the adaptive batch size needs the certified accounting",
-                });
-            }
         }
         if let VDirection::Adam {
             lr,

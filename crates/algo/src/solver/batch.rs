@@ -1,6 +1,7 @@
 //! The adaptive batch size of sampled SEPG (docs/THEOREMS.md "An adaptive batch size",
-//! Propositions B and U; the future work the thesis names, after Papini, Pirotta and Restelli,
-//! "Adaptive batch size for safe policy gradients", NIPS 2017).
+//! Propositions B and U; future work in the thesis's Chapter 6, after Papini, Pirotta and
+//! Restelli, "Adaptive batch size for safe policy gradients", NIPS 2017, which the thesis's
+//! Sec 3.5 describes).
 //!
 //! With a confidence width ε(n) = b/√n of the v-gradient estimate from n trajectories and
 //! g = ‖∇_v J‖∞ > 0, the best guarantee of the greedy v-step under the coordinate bound that

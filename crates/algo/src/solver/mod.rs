@@ -41,7 +41,7 @@ use crate::core::config::{
 };
 use crate::core::error::{ConfigError, RunError};
 use crate::core::executor::Solver;
-use crate::core::options::{Confidence, Schedule, SepgOptions, WStep};
+use crate::core::options::{BatchRule, Confidence, Schedule, SepgOptions, WStep};
 use crate::core::record::Record;
 use crate::core::state::State;
 use crate::solver::exact::ExactSource;
@@ -57,6 +57,7 @@ pub struct PolicySolver {
     options: SepgOptions,
     source: Box<dyn GradientSource>,
     certified: bool,
+    batch: BatchRule,
 }
 
 impl std::fmt::Debug for PolicySolver {
@@ -137,6 +138,7 @@ impl PolicySolver {
             options,
             source,
             certified: config.certified(),
+            batch: BatchRule::Fixed,
         })
     }
 }
@@ -238,6 +240,35 @@ impl PolicySolver {
         self
     }
 
+    /// Sets how many trajectories each block of a SEPG iteration draws (the default is
+    /// [`BatchRule::Fixed`]: N split evenly among the blocks). With
+    /// [`BatchRule::Adaptive`] every block after the first iteration draws the size chosen
+    /// by [`batch::next_batch`] from the previous iteration's v-block, kept in
+    /// [`State::next_batch`] so that a resumed run continues bit for bit (docs/THEOREMS.md "An
+    /// adaptive batch size"). The comparison algorithms ignore the rule.
+    ///
+    /// # Errors
+    /// As [`BatchRule::validate`] with the solver's accounting.
+    ///
+    /// # Examples
+    /// ```
+    /// use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+    /// use sepg_algo::core::options::BatchRule;
+    /// use sepg_algo::solver::PolicySolver;
+    /// use sepg_mdp::env::Preset;
+    /// let checked = SepgConfig::new(Preset::Lqg1d.build(), Algorithm::Sepg(Requirement::Mi)).check()?;
+    /// let rule = BatchRule::Adaptive { n_min: 50, n_max: 250_000 };
+    /// assert!(PolicySolver::new(&checked)?.with_batch_rule(rule).is_ok());
+    /// let bad = BatchRule::Adaptive { n_min: 50, n_max: 49 };
+    /// assert!(PolicySolver::new(&checked)?.with_batch_rule(bad).is_err());
+    /// # Ok::<(), sepg_algo::core::error::ConfigError>(())
+    /// ```
+    pub fn with_batch_rule(mut self, rule: BatchRule) -> Result<Self, ConfigError> {
+        rule.validate(self.options.accounting)?;
+        self.batch = rule;
+        Ok(self)
+    }
+
     /// Replaces the SEPG options of this solver, e.g. one built by
     /// [`PolicySolver::with_collector`], which starts from [`SepgOptions::default`] with
     /// [`Schedule::Iteration`] (a collector that reproduces the thesis's pseudocode sets
@@ -245,9 +276,11 @@ impl PolicySolver {
     ///
     /// # Errors
     /// As [`SepgOptions::validate`]; [`ConfigError::UnsupportedOption`] for a schedule other
-    /// than the solver's (its widths are built for it).
+    /// than the solver's (its widths are built for it), or for the estimated accounting when
+    /// the solver has an adaptive batch rule.
     pub fn with_options(mut self, options: SepgOptions) -> Result<Self, ConfigError> {
         options.validate()?;
+        self.batch.validate(options.accounting)?;
         check_v_direction(&options, &self.constants)?;
         if options.schedule != self.options.schedule
             || options.confidence != self.options.confidence
@@ -309,6 +342,7 @@ impl PolicySolver {
                 estimator,
             )),
             certified: true,
+            batch: BatchRule::Fixed,
         })
     }
 }
@@ -357,6 +391,7 @@ impl PolicySolver {
                     opts: &self.options,
                     certify: self.certified,
                     features: self.dims.0 / self.dims.1.max(1),
+                    batch: self.batch,
                 };
                 sepg::iterate(&mut *self.source, &setup, state)
             }

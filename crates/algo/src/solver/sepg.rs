@@ -83,6 +83,8 @@ pub(crate) struct Setup<'a> {
     /// components): the feature 2-norm of a step along a non-coordinate direction is bounded
     /// by √p·M_φ.
     pub(crate) features: usize,
+    /// How many trajectories each block draws (the certified iteration only).
+    pub(crate) batch: BatchRule,
 }
 
 /// The v-update of a block whose estimate `e` holds ∇_v J, from (`v`, `w`) for `required`:
@@ -878,7 +880,7 @@ fn iterate_certified(
 /// The batch sizes of the blocks of the iteration `state` is at: all `state.next_batch` under
 /// [`BatchRule::Adaptive`] once chosen, otherwise N split evenly ([`split`]).
 fn block_sizes(setup: &Setup, state: &State) -> Vec<usize> {
-    match (setup.opts.batch, state.next_batch) {
+    match (setup.batch, state.next_batch) {
         (BatchRule::Adaptive { .. }, Some(m)) => vec![m; setup.req.blocks()],
         _ => split(setup.n, setup.req.blocks()),
     }
@@ -887,7 +889,7 @@ fn block_sizes(setup: &Setup, state: &State) -> Vec<usize> {
 /// Under [`BatchRule::Adaptive`], the block size of the next iteration from this iteration's
 /// v-block estimate `ev` of `n_v` trajectories ([`next_batch`]); `None` under the fixed rule.
 fn adapted_batch(setup: &Setup, ev: &BlockEstimate, n_v: usize) -> Result<Option<usize>, RunError> {
-    let BatchRule::Adaptive { n_min, n_max } = setup.opts.batch else {
+    let BatchRule::Adaptive { n_min, n_max } = setup.batch else {
         return Ok(None);
     };
     let grad_v = ev.grad_v.as_ref().ok_or(RunError::Estimator(

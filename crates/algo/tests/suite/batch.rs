@@ -1,7 +1,7 @@
 //! The adaptive batch size (`BatchRule::Adaptive`, docs/THEOREMS.md "An adaptive batch
 //! size"): the rule against an independent maximisation of the guaranteed improvement per
 //! trajectory, its range, and its use by the sampled SEPG solver.
-use sepg_algo::core::config::{Algorithm, Requirement, SepgConfig};
+use sepg_algo::core::config::{Algorithm, CheckedConfig, Requirement, SepgConfig};
 use sepg_algo::core::error::ConfigError;
 use sepg_algo::core::executor::{Collect, Executor};
 use sepg_algo::core::options::{Accounting, BatchRule, Confidence, SepgOptions};
@@ -125,26 +125,30 @@ fn extreme_inputs_stay_in_range() {
     }
 }
 
-fn adaptive_config(n_min: usize, n_max: usize, seed: u64) -> SepgConfig {
+/// SEPG-MI on `lqg1d` with Student-t widths (so that it steps at small batches), N = 40.
+fn checked(seed: u64) -> CheckedConfig {
     let mut cfg = SepgConfig::new(lqg1d(true), Algorithm::Sepg(Requirement::Mi));
     cfg.seed = seed;
     cfg.iterations = 12;
     cfg.n_trajectories = 40;
     cfg.options.confidence = Confidence::StudentT { factor: 1.0 };
-    cfg.options.batch = BatchRule::Adaptive { n_min, n_max };
-    cfg
+    cfg.check().expect("valid")
+}
+
+fn solver(checked: &CheckedConfig, rule: BatchRule) -> PolicySolver {
+    PolicySolver::new(checked)
+        .expect("solver")
+        .with_batch_rule(rule)
+        .expect("valid rule")
 }
 
 #[test]
 fn adaptive_runs_draw_every_later_block_within_the_range_and_resume_bit_for_bit() {
     let (n_min, n_max) = (10, 300);
-    let checked = adaptive_config(n_min, n_max, 3).check().expect("valid");
+    let rule = BatchRule::Adaptive { n_min, n_max };
+    let checked = checked(3);
     let mut log = Collect::default();
-    let mut exec = Executor::new(
-        PolicySolver::new(&checked).expect("solver"),
-        checked.initial_state(),
-    )
-    .observe(&mut log);
+    let mut exec = Executor::new(solver(&checked, rule), checked.initial_state()).observe(&mut log);
     exec.run(12).expect("run");
     drop(exec);
     let mut before = 0;
@@ -170,19 +174,15 @@ fn adaptive_runs_draw_every_later_block_within_the_range_and_resume_bit_for_bit(
 
     // 5 iterations, the state through JSON (the checkpoint), 7 more: the same records
     let mut first = Collect::default();
-    let mut exec = Executor::new(
-        PolicySolver::new(&checked).expect("solver"),
-        checked.initial_state(),
-    )
-    .observe(&mut first);
+    let mut exec =
+        Executor::new(solver(&checked, rule), checked.initial_state()).observe(&mut first);
     exec.run(5).expect("run");
     let json = serde_json::to_string(exec.state()).expect("serialise");
     drop(exec);
     assert!(json.contains("next_batch"));
     let state: State = serde_json::from_str(&json).expect("deserialise");
     let mut rest = Collect::default();
-    let mut exec =
-        Executor::new(PolicySolver::new(&checked).expect("solver"), state).observe(&mut rest);
+    let mut exec = Executor::new(solver(&checked, rule), state).observe(&mut rest);
     exec.run(7).expect("run");
     drop(exec);
     first.records.extend(rest.records);
@@ -190,56 +190,59 @@ fn adaptive_runs_draw_every_later_block_within_the_range_and_resume_bit_for_bit(
 }
 
 #[test]
-fn the_fixed_rule_writes_no_batch_into_the_state_or_the_options() {
-    let mut cfg = adaptive_config(10, 300, 0);
-    cfg.options.batch = BatchRule::Fixed;
-    let checked = cfg.check().expect("valid");
-    let mut exec = Executor::new(
-        PolicySolver::new(&checked).expect("solver"),
-        checked.initial_state(),
-    );
+fn the_fixed_rule_writes_no_batch_into_the_state() {
+    let checked = checked(0);
+    let mut exec = Executor::new(solver(&checked, BatchRule::Fixed), checked.initial_state());
     exec.run(2).expect("run");
     assert_eq!(exec.state().next_batch, None);
     let state = serde_json::to_value(exec.state()).expect("serialise");
     assert!(state.get("next_batch").is_none());
-    let options = serde_json::to_value(SepgOptions::default()).expect("serialise");
-    assert!(options.get("batch").is_none());
-    let adaptive = SepgOptions {
-        batch: BatchRule::Adaptive {
-            n_min: 50,
-            n_max: 500,
-        },
-        ..SepgOptions::default()
+    let rule = BatchRule::Adaptive {
+        n_min: 50,
+        n_max: 500,
     };
-    let json = serde_json::to_value(adaptive).expect("serialise");
+    let json = serde_json::to_value(rule).expect("serialise");
     assert_eq!(
-        json["batch"],
+        json,
         serde_json::json!({"adaptive": {"n_min": 50, "n_max": 500}})
     );
 }
 
 #[test]
 fn bad_adaptive_rules_are_refused() {
+    let checked = checked(0);
     for (n_min, n_max) in [(1, 10), (0, 10), (20, 19)] {
-        let o = SepgOptions {
-            batch: BatchRule::Adaptive { n_min, n_max },
-            ..SepgOptions::default()
-        };
+        let rule = BatchRule::Adaptive { n_min, n_max };
         assert!(
-            matches!(o.validate(), Err(ConfigError::InvalidHyperParameter { .. })),
+            matches!(
+                PolicySolver::new(&checked)
+                    .expect("solver")
+                    .with_batch_rule(rule),
+                Err(ConfigError::InvalidHyperParameter { .. })
+            ),
             "[{n_min}, {n_max}]"
         );
     }
+    let rule = BatchRule::Adaptive {
+        n_min: 2,
+        n_max: 10,
+    };
+    // the solver's own options but for the accounting
     let estimated = SepgOptions {
         accounting: Accounting::Estimated,
-        batch: BatchRule::Adaptive {
-            n_min: 2,
-            n_max: 10,
-        },
-        ..SepgOptions::default()
+        ..checked.config().options
     };
     assert!(matches!(
-        estimated.validate(),
+        rule.validate(Accounting::Estimated),
+        Err(ConfigError::UnsupportedOption {
+            option: "batch",
+            ..
+        })
+    ));
+    // and an adaptive solver refuses to be switched to the estimated accounting
+    let adaptive = solver(&checked, rule);
+    assert!(matches!(
+        adaptive.with_options(estimated),
         Err(ConfigError::UnsupportedOption {
             option: "batch",
             ..
