@@ -21,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 
 /// Largest dimension for which [`LqgModel::r_max`] enumerates every box corner exactly
 /// (`2^16` corners); above it a guaranteed upper bound is returned instead.
-pub(crate) const EXACT_CORNER_MAX_DIM: usize = 16;
+const EXACT_CORNER_MAX_DIM: usize = 16;
 
 /// Relative tolerance used to accept `Q` and `R` as symmetric and positive semi-definite.
 const PSD_TOL: f64 = 1e-10;

@@ -1034,13 +1034,15 @@ pub fn save(fig: &Figure, path: &Path, style: &Style) -> Result<()> {
                 .prefix(".sepg-figure-")
                 .suffix(".png")
                 .tempfile_in(&dir)
-                .map_err(|e| Error::failed(format!("cannot write in {}: {e}", dir.display())))?;
+                .map_err(|e| {
+                    Error::failed_from(format_args!("cannot write in {}", dir.display()), e)
+                })?;
             {
                 let root = BitMapBackend::new(tmp.path(), size(fig, style)).into_drawing_area();
                 draw(&root, fig, Pen::Pixels, style).map_err(fail)?;
             }
             tmp.persist(path).map_err(|e| {
-                Error::failed(format!("cannot write {}: {}", path.display(), e.error))
+                Error::failed_from(format_args!("cannot write {}", path.display()), e.error)
             })?;
             Ok(())
         }

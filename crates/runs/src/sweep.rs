@@ -317,10 +317,11 @@ pub fn parse_shard(s: &str) -> Result<Shard> {
 pub fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<Shard> {
     let read = |name: &str, default: Option<usize>| -> Result<usize> {
         match (var(name), default) {
-            (Some(text), _) => text.trim().parse::<usize>().map_err(|_| {
+            (Some(text), _) => text.trim().parse::<usize>().map_err(|e| {
                 Error::invalid(format!(
                     "--shard slurm: {name}={text:?} is not a non-negative integer"
                 ))
+                .with_source(e)
             }),
             (None, Some(d)) => Ok(d),
             (None, None) => Err(Error::invalid(format!(

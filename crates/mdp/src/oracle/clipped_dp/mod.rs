@@ -73,7 +73,7 @@ const KINK_WEIGHT: f64 = 1e-16;
 /// Maximal number of exact kinks of the value function tracked.
 const MAX_KINKS: usize = 4096;
 /// Maximal number of Chebyshev nodes per element.
-pub(crate) const MAX_NODES: usize = 32;
+const MAX_NODES: usize = 32;
 /// Maximal number of initial-state intervals of the exact deterministic method.
 const MAX_PIECES: usize = 1_000_000;
 
