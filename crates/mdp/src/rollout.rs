@@ -682,18 +682,36 @@ pub(crate) fn scalar_kernel<const K: usize, S: LaneSink<K>, const STOCH: bool>(
     sink: &mut S,
 ) -> [f64; K] {
     let clipped_scores = S::SCORES && STOCH && pol.score == ScoreAction::Clipped;
-    match (p.clipping, clipped_scores) {
-        (true, false) => scalar_kernel_impl::<K, S, STOCH, true, false>(p, pol, limit, rngs, sink),
-        (false, false) => {
-            scalar_kernel_impl::<K, S, STOCH, false, false>(p, pol, limit, rngs, sink)
-        }
-        (true, true) => scalar_kernel_impl::<K, S, STOCH, true, true>(p, pol, limit, rngs, sink),
-        (false, true) => scalar_kernel_impl::<K, S, STOCH, false, true>(p, pol, limit, rngs, sink),
+    if p.noise_std > 0.0 {
+        scalar_kernel_noise::<K, S, STOCH, true>(p, pol, limit, rngs, sink, clipped_scores)
+    } else {
+        scalar_kernel_noise::<K, S, STOCH, false>(p, pol, limit, rngs, sink, clipped_scores)
     }
 }
 
-/// [`scalar_kernel`] with the clipping and the scored action (`CSCORE`: the clipped one)
-/// decided at compile time. Each step first draws the lanes' variates (policy stream, then
+/// [`scalar_kernel`] with the transition noise (`NOISY`) decided at compile time.
+#[inline(always)]
+fn scalar_kernel_noise<const K: usize, S: LaneSink<K>, const STOCH: bool, const NOISY: bool>(
+    p: &ScalarLqg,
+    pol: ScalarPolicy,
+    limit: usize,
+    rngs: &mut [TrajectoryRngs; K],
+    sink: &mut S,
+    clipped_scores: bool,
+) -> [f64; K] {
+    let (r, l) = (rngs, limit);
+    match (p.clipping, clipped_scores) {
+        (true, false) => scalar_kernel_impl::<K, S, STOCH, true, false, NOISY>(p, pol, l, r, sink),
+        (false, false) => {
+            scalar_kernel_impl::<K, S, STOCH, false, false, NOISY>(p, pol, l, r, sink)
+        }
+        (true, true) => scalar_kernel_impl::<K, S, STOCH, true, true, NOISY>(p, pol, l, r, sink),
+        (false, true) => scalar_kernel_impl::<K, S, STOCH, false, true, NOISY>(p, pol, l, r, sink),
+    }
+}
+
+/// [`scalar_kernel`] with the clipping, the scored action (`CSCORE`: the clipped one) and
+/// the transition noise decided at compile time. Each step first draws the lanes' variates (policy stream, then
 /// environment stream, in the same per-stream order as the generic kernel), then runs the
 /// short branch-free arithmetic over the lanes.
 #[inline(always)]
@@ -703,6 +721,7 @@ fn scalar_kernel_impl<
     const STOCH: bool,
     const CLIP: bool,
     const CSCORE: bool,
+    const NOISY: bool,
 >(
     p: &ScalarLqg,
     pol: ScalarPolicy,
@@ -717,7 +736,7 @@ fn scalar_kernel_impl<
         inv_sigma,
         ..
     } = pol;
-    let noisy = p.noise_std > 0.0;
+    let noisy = NOISY;
     let mut s: [f64; K] =
         std::array::from_fn(|k| uniform(&mut rngs[k].env, p.init_low, p.init_high));
     let (mut cv, mut cw, mut ret) = ([0.0; K], [0.0; K], [0.0; K]);
