@@ -586,7 +586,10 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_required_improvement, m)?)?;
     // the names and defaults the Python package reads (one table, in sepg_algo)
     m.add("_ALGORITHMS", PyTuple::new(m.py(), AlgoName::names())?)?;
-    m.add("_REQUIREMENTS", PyTuple::new(m.py(), RequirementName::names())?)?;
+    m.add(
+        "_REQUIREMENTS",
+        PyTuple::new(m.py(), RequirementName::names())?,
+    )?;
     m.add("_DEFAULT_ALGORITHM", DEFAULT_ALGO.name())?;
     m.add("_DEFAULT_REQUIREMENT", DEFAULT_REQUIREMENT.name())?;
     m.add("_DEFAULT_CONSTANTS", RUN_CONSTANTS.name())?;
