@@ -4,7 +4,25 @@ use std::str::FromStr;
 
 use sepg_mdp::oracle::Horizon;
 
-pub use sepg_mdp::env::LqgPreset;
+/// An LQG preset of `sepg_mdp` as a plain argument: parsed with [`FromStr`], whose message
+/// names the expected presets, where the preset's `ValueEnum` would list them instead.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LqgPreset(pub sepg_mdp::env::LqgPreset);
+
+impl LqgPreset {
+    /// The preset's name as typed on the command line.
+    pub fn name(self) -> &'static str {
+        self.0.name()
+    }
+}
+
+impl FromStr for LqgPreset {
+    type Err = sepg_mdp::env::EnvError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        s.parse().map(LqgPreset)
+    }
+}
 
 /// A horizon: a positive integer or `inf`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -525,17 +525,6 @@ impl FromStr for LqgPreset {
     }
 }
 
-/// A plain `#[arg]` of this type parses with [`FromStr`], whose message names the expected
-/// presets, rather than as a `ValueEnum` (which `#[arg(value_enum)]` still selects).
-#[cfg(feature = "clap")]
-impl clap::builder::ValueParserFactory for LqgPreset {
-    type Parser = fn(&str) -> Result<LqgPreset, EnvError>;
-
-    fn value_parser() -> Self::Parser {
-        LqgPreset::from_str
-    }
-}
-
 /// Any of the crate's environments, dispatching statically per variant (the fused scalar LQG
 /// kernel stays available through [`Environment::as_scalar_lqg`]).
 #[derive(Debug, Clone, PartialEq)]

@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use numpy::PyArray2;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyModule};
+use pyo3::types::{PyDict, PyModule, PyTuple};
 use sepg_algo::core::check::{OnContradiction, RawSteps};
 use sepg_algo::core::config::Algorithm;
 use sepg_algo::core::defaults::{
@@ -585,8 +585,11 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trainer>()?;
     m.add_function(wrap_pyfunction!(_required_improvement, m)?)?;
     // the names and defaults the Python package reads (one table, in sepg_algo)
-    m.add("_ALGORITHMS", AlgoName::names())?;
-    m.add("_REQUIREMENTS", RequirementName::names())?;
+    m.add("_ALGORITHMS", PyTuple::new(m.py(), AlgoName::names())?)?;
+    m.add(
+        "_REQUIREMENTS",
+        PyTuple::new(m.py(), RequirementName::names())?,
+    )?;
     m.add("_DEFAULT_ALGORITHM", DEFAULT_ALGO.name())?;
     m.add("_DEFAULT_REQUIREMENT", DEFAULT_REQUIREMENT.name())?;
     m.add("_DEFAULT_CONSTANTS", RUN_CONSTANTS.name())?;
