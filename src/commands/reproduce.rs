@@ -33,7 +33,7 @@ pub struct ReproduceArgs {
     #[arg(long, allow_negative_numbers = true)]
     iterations: Option<u64>,
     /// Confidence δ of the sampled gradients.
-    #[arg(long, default_value_t = 0.2, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = sepg_algo::DEFAULT_DELTA, allow_negative_numbers = true)]
     delta: f64,
     /// σ⁰ of the LQG figures (fig-5.1 to fig-5.3).
     #[arg(

@@ -8,7 +8,7 @@ use numpy::PyArray2;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule, PyTuple};
-use sepg_algo::core::check::{OnContradiction, RawSteps};
+use sepg_algo::core::check::RawSteps;
 use sepg_algo::core::config::Algorithm;
 use sepg_algo::core::defaults::{
     DEFAULT_ADAM_BETA1, DEFAULT_ADAM_BETA2, DEFAULT_ADAM_EPS, DEFAULT_ALGO, DEFAULT_BUDGET0,
@@ -26,6 +26,7 @@ use sepg_algo::solver::{CollectedConfig, PolicySolver};
 use sepg_estimators::GradientSpec;
 use sepg_mdp::rng::Stream;
 use sepg_mdp::{Batch, GaussianPolicy};
+use sepg_runs::spec::{AccountingName, OnContradictionName, VDirectionName};
 
 use crate::record;
 use crate::safe::lengths_of;
@@ -72,26 +73,30 @@ pub(crate) fn algorithm(
     })
 }
 
-/// SEPG's v-direction named `name` ("greedy" or "adam") with Adam's parameters, which are
-/// refused without "adam"; "adam" needs `lr`, and its betas and ε default to 0.9, 0.999 and
-/// 1e-8 (their domains are checked with the configuration).
+/// SEPG's v-direction named `name` (greedy or adam, [`VDirectionName`]; `None` for the
+/// default of [`SepgOptions`]) with Adam's parameters, which are refused without adam; adam
+/// needs `lr`, and its betas and ε default to [`DEFAULT_ADAM_BETA1`], [`DEFAULT_ADAM_BETA2`]
+/// and [`DEFAULT_ADAM_EPS`] (their domains are checked with the configuration).
 fn v_direction(
-    name: &str,
+    name: Option<VDirectionName>,
     lr: Option<f64>,
     beta1: Option<f64>,
     beta2: Option<f64>,
     eps: Option<f64>,
 ) -> PyResult<VDirection> {
     match name {
-        "greedy" => {
+        None | Some(VDirectionName::Greedy) => {
             if lr.is_some() || beta1.is_some() || beta2.is_some() || eps.is_some() {
                 return Err(invalid(
                     "adam_lr, adam_beta1, adam_beta2 and adam_eps apply only with v_direction=\"adam\"",
                 ));
             }
-            Ok(VDirection::Greedy)
+            Ok(match name {
+                None => SepgOptions::default().v_direction,
+                _ => VDirection::Greedy,
+            })
         }
-        "adam" => {
+        Some(VDirectionName::Adam) => {
             let lr = lr.ok_or_else(|| invalid("v_direction=\"adam\" needs adam_lr"))?;
             Ok(VDirection::Adam {
                 lr,
@@ -100,10 +105,15 @@ fn v_direction(
                 eps: eps.unwrap_or(DEFAULT_ADAM_EPS),
             })
         }
-        other => Err(invalid(format!(
-            "v_direction = {other:?} must be \"greedy\" or \"adam\""
-        ))),
     }
+}
+
+/// The value named `name` of the option `option`, parsed by the names of configurations and
+/// of the command line (`sepg_runs::spec`), so Python accepts exactly the same names.
+fn value_name<T: serde::de::DeserializeOwned>(option: &str, name: &str) -> PyResult<T> {
+    use serde::de::IntoDeserializer;
+    T::deserialize(name.into_deserializer())
+        .map_err(|e: serde::de::value::Error| invalid(format!("{option} = {name:?}: {e}")))
 }
 
 /// What the collector is asked for: `n` trajectories of the policy
@@ -338,7 +348,7 @@ impl Trainer {
     /// raises at the first value beyond its bound, "continue" goes on and records the
     /// contradiction in the state's `constants_check` (no guarantee).
     #[new]
-    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = DEFAULT_REQUIREMENT.name(), alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = "certified", v_direction = "greedy", adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = "stop", **unknown))]
+    #[pyo3(signature = (algorithm, constants, actions, features, collector, *, n_trajectories = None, seed = None, delta = None, v0 = None, sigma0 = None, initial_budget = None, nu = None, requirement = DEFAULT_REQUIREMENT.name(), alpha = None, beta = None, lr = None, lr_w = None, reference_batch = None, accounting = None, v_direction = None, adam_lr = None, adam_beta1 = None, adam_beta2 = None, adam_eps = None, on_contradiction = None, **unknown))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         algorithm: &str,
@@ -359,13 +369,13 @@ impl Trainer {
         lr: Option<f64>,
         lr_w: Option<f64>,
         reference_batch: Option<usize>,
-        accounting: &str,
-        v_direction: &str,
+        accounting: Option<&str>,
+        v_direction: Option<&str>,
         adam_lr: Option<f64>,
         adam_beta1: Option<f64>,
         adam_beta2: Option<f64>,
         adam_eps: Option<f64>,
-        on_contradiction: &str,
+        on_contradiction: Option<&str>,
         unknown: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         if let Some(key) = unknown.and_then(|d| d.keys().iter().next()) {
@@ -519,10 +529,10 @@ fn initial_state(
 /// contradiction, each named as in [`Trainer`]'s constructor.
 fn trainer_options(
     reference_batch: Option<usize>,
-    accounting: &str,
-    v_direction: &str,
+    accounting: Option<&str>,
+    v_direction: Option<&str>,
     adam: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
-    on_contradiction: &str,
+    on_contradiction: Option<&str>,
 ) -> PyResult<SepgOptions> {
     // the trainer knows no iteration count, so δ is not spread over a run: every width is
     // at level δ, Student-t (docs/THEOREMS.md, "Statements over a whole run")
@@ -536,27 +546,22 @@ fn trainer_options(
     if let Some(n0) = reference_batch {
         options.reference_batch = n0;
     }
-    options.accounting = match accounting {
-        "certified" => Accounting::Certified,
-        "estimated" => Accounting::Estimated,
-        other => {
-            return Err(invalid(format!(
-                "accounting = {other:?} must be \"certified\" or \"estimated\""
-            )));
-        }
-    };
+    if let Some(name) = accounting {
+        options.accounting = match value_name("accounting", name)? {
+            AccountingName::Certified => Accounting::Certified,
+            AccountingName::Estimated => Accounting::Estimated,
+        };
+    }
     let (adam_lr, adam_beta1, adam_beta2, adam_eps) = adam;
+    let v_direction = v_direction
+        .map(|name| value_name("v_direction", name))
+        .transpose()?;
     options.v_direction =
         self::v_direction(v_direction, adam_lr, adam_beta1, adam_beta2, adam_eps)?;
-    options.on_contradiction = match on_contradiction {
-        "stop" => OnContradiction::Stop,
-        "continue" => OnContradiction::Continue,
-        other => {
-            return Err(invalid(format!(
-                "on_contradiction = {other:?} must be \"stop\" or \"continue\""
-            )));
-        }
-    };
+    if let Some(name) = on_contradiction {
+        options.on_contradiction =
+            value_name::<OnContradictionName>("on_contradiction", name)?.option();
+    }
     Ok(options)
 }
 

@@ -414,8 +414,8 @@ def test_the_certified_steps_are_those_of_the_command_line():
 
 def test_the_report_holds_the_closed_forms_and_labels_a_certified_step_as_its_certificate():
     # Theorem 4.2 at gamma = 1/2, R = M_phi = |A| = sigma = 1: c = 4 (1/sqrt(2 pi) + 1/2).
-    r = _native.bounds_report(0.5, 1.0, 1.0, 1.0, 1.0, grad_v=[0.3, -0.8], grad_w=0.4, required=-0.01,
-                              certified=True)
+    r = bounds.bounds_report(0.5, 1.0, 1.0, 1.0, 1.0, grad_v=[0.3, -0.8], grad_w=0.4, required=-0.01,
+                             certified=True)
     c = 4.0 * (1.0 / math.sqrt(2.0 * math.pi) + 0.5)
     assert r["c"] == pytest.approx(c, rel=1e-14)
     assert r["alpha_star"] == pytest.approx(1.0 / (2.0 * c), rel=1e-15)

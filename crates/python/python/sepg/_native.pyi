@@ -335,13 +335,13 @@ class Trainer:
         lr: Optional[float] = None,
         lr_w: Optional[float] = None,
         reference_batch: Optional[int] = None,
-        accounting: str = "certified",
-        v_direction: str = "greedy",
+        accounting: Optional[str] = None,
+        v_direction: Optional[str] = None,
         adam_lr: Optional[float] = None,
         adam_beta1: Optional[float] = None,
         adam_beta2: Optional[float] = None,
         adam_eps: Optional[float] = None,
-        on_contradiction: str = "stop",
+        on_contradiction: Optional[str] = None,
     ) -> None: ...
     def run(self, iterations: int) -> List[Dict[str, Any]]: ...
     def state(self) -> str: ...

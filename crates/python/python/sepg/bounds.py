@@ -26,6 +26,8 @@ prefix                        thesis
 :class:`Enclosure`,           rounding of C_max (docs/THEOREMS.md, "Certified steps");
 :class:`Certified`            the adaptive step of Corollary 3.11 with its guarantee
 ``budget_``, :class:`Budget`  Definition 4.3, Theorem 4.1, eqs. (4.13)-(4.14)
+:func:`bounds_report`         every quantity above at one point, as a dict: the report
+                              of ``sepg bounds --json``, built by the same library code
 ============================  ==========================================================
 
 Invalid input raises :class:`sepg.errors.InvalidInputError` (a ``ValueError``).
@@ -42,6 +44,7 @@ from sepg._native import (
     StepOutcome,
     TaskConstants,
     batch_size_gpomdp,
+    bounds_report,
     batch_size_reinforce,
     budget_split_requirement,
     certified_adaptive_step,
@@ -118,6 +121,7 @@ __all__ = [
     "TaskConstants",
     "batch_size_gpomdp",
     "batch_size_reinforce",
+    "bounds_report",
     "budget_split_requirement",
     "certified_adaptive_step",
     "certified_c",

@@ -71,14 +71,14 @@ class SEPG:
         rewards: Optional[str] = None,
         nu: float = _DEFAULT_NU,
         reference_batch: Optional[int] = None,
-        accounting: str = "certified",
-        v_direction: str = "greedy",
+        accounting: Optional[str] = None,
+        v_direction: Optional[str] = None,
         adam_lr: Optional[float] = None,
         adam_beta1: Optional[float] = None,
         adam_beta2: Optional[float] = None,
         adam_eps: Optional[float] = None,
         show_derivation: bool = True,
-        on_contradiction: str = "stop",
+        on_contradiction: Optional[str] = None,
     ) -> None:
         if requirement not in _REQUIREMENTS:
             raise InvalidInputError(
