@@ -28,8 +28,9 @@ impl Resolved {
     /// # Errors
     /// [`Error::Failed`] if serialisation fails.
     pub fn toml(&self) -> Result<String> {
-        let mut text = toml::to_string(&self.spec)
-            .map_err(|e| Error::failed(format!("cannot serialise the configuration: {e}")))?;
+        let mut text = toml::to_string(&self.spec).map_err(|e| {
+            Error::failed(format!("cannot serialise the configuration: {e}")).with_source(e)
+        })?;
         let used = crate::folder::UsedConstants::of(self);
         text.push_str(&format!(
             "# constants used by the bounds: {}",
