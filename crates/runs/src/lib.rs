@@ -45,7 +45,7 @@ pub mod setup;
 pub mod spec;
 pub mod sweep;
 
-pub use error::{Error, Result};
+pub use error::{Error, Message, Result, Source};
 pub use run::{RunObserver, RunOptions, Silent, resume, start};
 pub use spec::{Resolved, RunSpec};
 pub use sweep::{SweepOptions, SweepSpec};
