@@ -1064,3 +1064,138 @@ fn safe_adam_where_unproven_is_one_line_exit_2() {
     );
     assert!(line.contains("v-direction"), "{line}");
 }
+
+/// The arguments of a sampled SEPG-MI run on `lqg1d` with the adaptive batch rule, each block
+/// clamped to [2,000, 2,100] trajectories.
+fn adaptive_args(dir: &Path, iterations: &str) -> Vec<String> {
+    [
+        "run",
+        "--env",
+        "lqg1d",
+        "--algo",
+        "sepg-mi",
+        "--iterations",
+        iterations,
+        "--batch-rule",
+        "adaptive",
+        "--batch-min",
+        "2000",
+        "--batch-max",
+        "2100",
+        "--quiet",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([dir.display().to_string()])
+    .collect()
+}
+
+/// The adaptive batch rule on the command line reaches the algorithm: the first iteration
+/// draws N = 100 trajectories (two blocks of 50), every later one two blocks of 2,000–2,100
+/// (the rule's choice clamped to the bounds given; the rule itself is checked against a
+/// brute-force maximisation in sepg-algo), the rule is recorded in config.toml, and a run
+/// stopped by SIGINT at a checkpoint resumes with it to the uninterrupted run, bit for bit.
+#[test]
+fn the_adaptive_batch_rule_draws_its_blocks_within_its_bounds_and_resumes() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let reference = tmp.path().join("reference");
+    sepg_ok(&adaptive_args(&reference, "1500"));
+    let config = read(&reference.join("config.toml"));
+    for line in [
+        "batch-rule = \"adaptive\"",
+        "batch-min = 2000",
+        "batch-max = 2100",
+    ] {
+        assert!(config.lines().any(|l| l == line), "{line} in {config}");
+    }
+    let log = read(&reference.join("log.csv"));
+    let mut lines = log.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = header
+        .iter()
+        .position(|c| *c == "trajectories")
+        .expect("trajectories column");
+    let counts: Vec<u64> = lines
+        .map(|l| l.split(',').nth(col).expect("cell").parse().expect("count"))
+        .collect();
+    // the column counts the trajectories drawn so far
+    assert_eq!(counts.len(), 1500);
+    assert_eq!(counts[0], 100, "{:?}", &counts[..5]);
+    assert!(
+        counts
+            .windows(2)
+            .all(|w| (4000..=4200).contains(&(w[1] - w[0]))),
+        "{:?}",
+        &counts[..5]
+    );
+    let dir = tmp.path().join("interrupted");
+    // About 1 ms per iteration of 4,000 trajectories: 1,400 iterations are left after the
+    // checkpoint of iteration 100, far more than sending the signal takes.
+    signal_after_checkpoint(adaptive_args(&dir, "1500"), &dir, 100, "-INT");
+    resume(&dir);
+    assert_same_run(&reference, &dir);
+}
+
+/// The adaptive batch rule is refused with one line and exit status 2 without its bounds, with
+/// the estimated accounting, with exact gradients and for the comparison algorithms, and its
+/// bounds without the rule; no run folder is written.
+#[test]
+fn the_adaptive_batch_rule_where_it_does_not_apply_is_one_line_exit_2() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("bad");
+    let o = out.display().to_string();
+    let adaptive = [
+        "--batch-rule",
+        "adaptive",
+        "--batch-min",
+        "50",
+        "--batch-max",
+        "100",
+    ];
+    for (algo, extra, needles) in [
+        (
+            "sepg-mi",
+            vec!["--batch-rule", "adaptive"],
+            ["batch-rule adaptive", "--batch-max"],
+        ),
+        (
+            "sepg-mi",
+            vec!["--batch-min", "50"],
+            ["batch-min", "without batch-rule adaptive"],
+        ),
+        (
+            "sepg-mi",
+            [&adaptive[..], &["--accounting", "estimated"]].concat(),
+            ["batch-rule adaptive", "estimated"],
+        ),
+        (
+            "sepg-mi",
+            [&adaptive[..], &["--gradients", "exact"]].concat(),
+            ["batch-rule", "exact gradients"],
+        ),
+        ("adastep", adaptive.to_vec(), ["batch-rule", "adastep"]),
+        (
+            "sepg-mi",
+            vec![
+                "--batch-rule",
+                "adaptive",
+                "--batch-min",
+                "1",
+                "--batch-max",
+                "100",
+            ],
+            ["batch", "2"],
+        ),
+    ] {
+        let args = [
+            &["run", "--env", "lqg1d", "--algo", algo, "--out", &o][..],
+            &extra[..],
+        ]
+        .concat();
+        let line = assert_rejected(&args, &out);
+        for needle in needles {
+            assert!(line.contains(needle), "{needle} in {line} for {args:?}");
+        }
+    }
+}

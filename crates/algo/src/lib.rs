@@ -26,7 +26,7 @@ pub use core::error::{ConfigError, RunError};
 pub use core::executor::{Collect, Executor, Observer, Solver};
 pub use core::names::{AlgoName, ConstantsName, RequirementName, UnknownName};
 pub use core::options::{
-    Accounting, ConstantsFamily, Schedule, SepgOptions, VDirection, WDirection, WStep,
+    Accounting, BatchRule, ConstantsFamily, Schedule, SepgOptions, VDirection, WDirection, WStep,
 };
 pub use core::record::Record;
 pub use core::state::State;

@@ -31,7 +31,6 @@ use sepg_algo::core::error::RunError;
 use sepg_algo::core::executor::Solver;
 use sepg_algo::core::record::Record;
 use sepg_algo::core::state::State;
-use sepg_algo::solver::PolicySolver;
 
 use crate::error::{Error, Result};
 use crate::folder::{
@@ -289,8 +288,7 @@ fn preflight(resolved: &Resolved) -> Result<Option<First>> {
     let refuse = |e: &dyn std::fmt::Display| {
         Error::invalid(format!("the run cannot start from its initial policy: {e}"))
     };
-    let mut solver = PolicySolver::new(&resolved.checked)
-        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")).with_source(e))?;
+    let mut solver = resolved.solver()?;
     if resolved.iterations() == 0 {
         return Ok(None);
     }
@@ -315,8 +313,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
     let total = resolved.iterations();
     let every = resolved.log_every();
     let mut writer = Writer::open(dir, ck)?;
-    let mut solver = PolicySolver::new(&resolved.checked)
-        .map_err(|e| Error::invalid(format!("invalid configuration: {e}")).with_source(e))?;
+    let mut solver = resolved.solver()?;
     let mut state = writer.ck.state.clone();
     if state.iteration == 0
         && let Err(e) = solver.init(&mut state)

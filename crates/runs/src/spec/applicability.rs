@@ -1,8 +1,8 @@
 //! The options that do not apply to a run's algorithm or gradients.
 
 use super::names::{
-    AccountingName, AlgoName, ConfidenceName, ConstantsName, GradientsName, RequirementName,
-    VDirectionName, WDirectionName,
+    AccountingName, AlgoName, BatchRuleName, ConfidenceName, ConstantsName, GradientsName,
+    RequirementName, VDirectionName, WDirectionName,
 };
 use super::run_spec::RunSpec;
 use crate::error::{Error, Result};
@@ -74,6 +74,15 @@ impl RunSpec {
         )?;
         self.reject_v_direction()?;
         reject(
+            !sepg
+                && (self.batch_rule.is_some()
+                    || self.batch_min.is_some()
+                    || self.batch_max.is_some()),
+            "batch-rule/batch-min/batch-max",
+            &for_algo,
+        )?;
+        self.reject_batch_rule()?;
+        reject(
             !sepg && self.certified_steps.is_some(),
             "certified-steps",
             &for_algo,
@@ -134,11 +143,39 @@ impl RunSpec {
             "to exact gradients",
         )?;
         reject(self.delta.is_some(), "delta", "to exact gradients")?;
+        reject(
+            self.batch_rule.is_some() || self.batch_min.is_some() || self.batch_max.is_some(),
+            "batch-rule/batch-min/batch-max",
+            "to exact gradients",
+        )?;
         reject(self.scores.is_some(), "scores", "to exact gradients")?;
         reject(
             self.estimator.is_some() || self.baseline.is_some() || self.baseline_fit.is_some(),
             "estimator/baseline/baseline-fit",
             "to exact gradients",
+        )
+    }
+
+    /// Refuses the adaptive batch rule's bounds without `batch-rule adaptive`, the rule without
+    /// both bounds, and the rule with the estimated accounting (its choice of n keeps the
+    /// run's union bound only for certified steps: docs/THEOREMS.md, "An adaptive batch
+    /// size"). The bounds' domains are checked by the algorithm's validation.
+    fn reject_batch_rule(&self) -> Result<()> {
+        let adaptive = self.batch_rule == Some(BatchRuleName::Adaptive);
+        reject(
+            !adaptive && (self.batch_min.is_some() || self.batch_max.is_some()),
+            "batch-min/batch-max",
+            "without batch-rule adaptive",
+        )?;
+        if adaptive && (self.batch_min.is_none() || self.batch_max.is_none()) {
+            return Err(Error::invalid(
+                "batch-rule adaptive needs --batch-min and --batch-max (trajectories per block)",
+            ));
+        }
+        reject(
+            adaptive && self.accounting == Some(AccountingName::Estimated),
+            "batch-rule adaptive",
+            "with accounting estimated (use accounting certified)",
         )
     }
 

@@ -24,9 +24,9 @@ pub use limits::{
     check_horizon,
 };
 pub use names::{
-    AccountingName, AlgoName, BaselineName, ConfidenceName, ConstantsName, EnvName, EstimatorName,
-    FitName, GradientsName, Lb1Name, OnContradictionName, RequirementName, RewardsName,
-    ScheduleName, ScoresName, VDirectionName, WDirectionName, WStepName,
+    AccountingName, AlgoName, BaselineName, BatchRuleName, ConfidenceName, ConstantsName, EnvName,
+    EstimatorName, FitName, GradientsName, Lb1Name, OnContradictionName, RequirementName,
+    RewardsName, ScheduleName, ScoresName, VDirectionName, WDirectionName, WStepName,
 };
 pub use resolved::Resolved;
 pub use run_spec::{RunSpec, toml_message};

@@ -148,6 +148,20 @@ pub enum AccountingName {
     Estimated,
 }
 
+/// How many trajectories each block of a sampled SEPG iteration draws, accepted by
+/// `--batch-rule` (docs/THEOREMS.md, "An adaptive batch size").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum BatchRuleName {
+    /// N trajectories per iteration, split evenly among its blocks (Algorithm 4.3).
+    Fixed,
+    /// After the first iteration, each block draws the n that maximises the guaranteed
+    /// improvement per trajectory of the v-step, n = 4b̂²/ĝ² from the previous iteration's
+    /// v-block, clamped to [`batch-min`, `batch-max`] (certified accounting only).
+    Adaptive,
+}
+
 /// How δ is spread over a run's confidence statements, accepted by `--schedule`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "clap", derive(ValueEnum))]

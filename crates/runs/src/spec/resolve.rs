@@ -87,6 +87,9 @@ impl RunSpec {
             scores: (gradients == GradientsName::Sampled)
                 .then_some(self.scores.unwrap_or(ScoresName::Raw)),
             certified_steps,
+            batch_rule: self.batch_rule,
+            batch_min: self.batch_min,
+            batch_max: self.batch_max,
             ..RunSpec::resolved_values(&method, &sampling, start, &schedule, options.as_ref())
         };
         Ok(Resolved {

@@ -1,10 +1,13 @@
 //! [`Resolved`], a run configuration with every default filled in and validated.
 
 use sepg_algo::core::config::CheckedConfig;
+use sepg_algo::core::error::ConfigError;
+use sepg_algo::core::options::BatchRule;
+use sepg_algo::solver::PolicySolver;
 use sepg_mdp::env::AnyEnv;
 use sepg_mdp::oracle::ClosedFormOracle;
 
-use super::names::RewardsName;
+use super::names::{BatchRuleName, RewardsName};
 use super::run_spec::RunSpec;
 use crate::error::{Error, Result};
 
@@ -20,6 +23,36 @@ pub struct Resolved {
 }
 
 impl Resolved {
+    /// The batch rule of a sampled SEPG run: [`BatchRule::Adaptive`] with the spec's bounds
+    /// under `batch-rule adaptive`, else [`BatchRule::Fixed`].
+    pub fn batch_rule(&self) -> BatchRule {
+        match (
+            self.spec.batch_rule,
+            self.spec.batch_min,
+            self.spec.batch_max,
+        ) {
+            (Some(BatchRuleName::Adaptive), Some(n_min), Some(n_max)) => {
+                BatchRule::Adaptive { n_min, n_max }
+            }
+            _ => BatchRule::Fixed,
+        }
+    }
+
+    /// The algorithm of this configuration, ready to iterate: [`PolicySolver::new`] with the
+    /// batch rule of [`Resolved::batch_rule`].
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] if the algorithm refuses the configuration or the batch rule.
+    pub fn solver(&self) -> Result<PolicySolver> {
+        let invalid =
+            |e: ConfigError| Error::invalid(format!("invalid configuration: {e}")).with_source(e);
+        let solver = PolicySolver::new(&self.checked).map_err(invalid)?;
+        match self.batch_rule() {
+            BatchRule::Fixed => Ok(solver),
+            rule => solver.with_batch_rule(rule).map_err(invalid),
+        }
+    }
+
     /// The resolved configuration as TOML text. The options are followed by comment lines
     /// that state the constants the bounds use: their family, and for the tight family its
     /// horizon, reward sign and S_H, then c and d at σ⁰ (comments, so that reading the file

@@ -8,9 +8,9 @@ use clap::Args;
 use serde::{Deserialize, Serialize};
 
 use super::names::{
-    AccountingName, AlgoName, BaselineName, ConfidenceName, ConstantsName, EnvName, EstimatorName,
-    FitName, GradientsName, Lb1Name, OnContradictionName, RequirementName, RewardsName,
-    ScheduleName, ScoresName, VDirectionName, WDirectionName, WStepName,
+    AccountingName, AlgoName, BaselineName, BatchRuleName, ConfidenceName, ConstantsName, EnvName,
+    EstimatorName, FitName, GradientsName, Lb1Name, OnContradictionName, RequirementName,
+    RewardsName, ScheduleName, ScoresName, VDirectionName, WDirectionName, WStepName,
 };
 use super::values::Values;
 #[cfg(feature = "clap")]
@@ -242,6 +242,26 @@ pub struct RunSpec {
     #[cfg_attr(feature = "clap", arg(long = "on-contradiction", value_enum))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub on_contradiction: Option<OnContradictionName>,
+    /// How many trajectories each block of a sampled SEPG iteration draws: N split evenly, or
+    /// the adaptive batch size (certified accounting only; needs batch-min and batch-max)
+    /// [default: fixed].
+    #[cfg_attr(feature = "clap", arg(long = "batch-rule", value_enum))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub batch_rule: Option<BatchRuleName>,
+    /// Smallest block size of the adaptive batch rule, in trajectories (≥ 2).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "batch-min", allow_negative_numbers = true)
+    )]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub batch_min: Option<usize>,
+    /// Largest block size of the adaptive batch rule, in trajectories (≥ batch-min).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "batch-max", allow_negative_numbers = true)
+    )]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub batch_max: Option<usize>,
 }
 
 macro_rules! overlay_fields {
@@ -259,7 +279,8 @@ impl RunSpec {
             estimator, baseline, baseline_fit, log_every, sepg_version, v_direction, adam_lr,
             adam_beta1, adam_beta2, adam_eps, w_step, w_direction, metagradient_clip, confidence, quantile_factor, lb1_requirement, alternating,
             reference_batch, gamma, r_max, m_phi, action_volume, psi, scores, certified_steps,
-            accounting, schedule, constants, rewards, on_contradiction)
+            accounting, schedule, constants, rewards, on_contradiction, batch_rule, batch_min,
+            batch_max)
     }
 
     /// Reads a TOML file of options; unknown keys are rejected.
