@@ -171,8 +171,13 @@ pub struct LqgEnv {
     scalar: Option<ScalarLqg>,
 }
 
+/// The horizon of the LQG environments unless set otherwise, `H = 20` (Sec 5.1;
+/// docs/CONVENTIONS.md §6), in steps.
+pub const LQG_HORIZON: usize = 20;
+
 impl LqgEnv {
-    /// The environment of a validated model, with the default horizon `H = 20` (docs/CONVENTIONS.md §6).
+    /// The environment of a validated model, with the default horizon [`LQG_HORIZON`] = 20
+    /// (docs/CONVENTIONS.md §6).
     ///
     /// ```
     /// use sepg_mdp::env::{Environment, LqgEnv};
@@ -206,7 +211,7 @@ impl LqgEnv {
             q: row_major(&model.q),
             r: row_major(&model.r),
             model,
-            horizon: 20,
+            horizon: LQG_HORIZON,
             n,
             l,
             scalar,

@@ -307,7 +307,7 @@ impl SepgConfig {
             v0: vec![DEFAULT_V0; dim_v],
             sigma0: vec![DEFAULT_SIGMA0; dim_w],
             n_trajectories: DEFAULT_N_TRAJECTORIES,
-            horizon: 20,
+            horizon: sepg_mdp::env::LQG_HORIZON,
             iterations: DEFAULT_ITERATIONS,
             seed: DEFAULT_SEED,
             initial_budget: DEFAULT_BUDGET0,
