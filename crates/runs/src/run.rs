@@ -378,13 +378,7 @@ fn drive(dir: &Path, resolved: &Resolved, ck: Checkpoint, opts: RunOptions<'_>) 
         }
     }
     opts.observer.end();
-    let Writer {
-        partial, log, ck, ..
-    } = writer;
-    drop(log);
-    fs::rename(&partial, dir.join(LOG_FILE)).map_err(|e| io_fail("rename", &partial, e))?;
-    opts.observer.wrote(LOG_FILE);
-    finish(dir, resolved, &ck, opts.observer)
+    close(dir, resolved, writer, opts.observer)
 }
 
 /// Ends a run whose iteration `before.iteration` saw `offence`, a value contradicting the
@@ -404,17 +398,28 @@ fn stop_contradicted(
     let message = RunError::ConstantsContradicted(Box::new(offence.clone())).to_string();
     before.constants_check.record(offence);
     writer.checkpoint(tally, &before, opts.observer)?;
+    close(dir, resolved, writer, opts.observer)?;
+    Err(Error::failed(format!(
+        "{}: run stopped: {message}",
+        dir.display()
+    )))
+}
+
+/// Closes the log of `writer` (log.partial.csv becomes log.csv) and finishes the folder with
+/// [`finish`]: the end of a complete run and of one stopped by a contradiction.
+fn close(
+    dir: &Path,
+    resolved: &Resolved,
+    writer: Writer,
+    observer: &dyn RunObserver,
+) -> Result<Summary> {
     let Writer {
         partial, log, ck, ..
     } = writer;
     drop(log);
     fs::rename(&partial, dir.join(LOG_FILE)).map_err(|e| io_fail("rename", &partial, e))?;
-    opts.observer.wrote(LOG_FILE);
-    finish(dir, resolved, &ck, opts.observer)?;
-    Err(Error::failed(format!(
-        "{}: run stopped: {message}",
-        dir.display()
-    )))
+    observer.wrote(LOG_FILE);
+    finish(dir, resolved, &ck, observer)
 }
 
 /// Writes `summary.json` from the final checkpoint `ck`, completing the run.
