@@ -559,6 +559,18 @@ mod tests {
     use crate::run::{RunOptions, Silent, start};
     use crate::spec::RunSpec;
 
+    /// The columns validated as counters or as optional are columns of log.csv: a name
+    /// misspelled here would leave its column validated as a plain number.
+    #[test]
+    fn the_validated_column_kinds_name_columns_of_the_log() {
+        for name in INTEGER_COLUMNS.iter().chain(&OPTIONAL_COLUMNS) {
+            assert!(
+                crate::folder::LOG_COLUMNS.contains(name),
+                "{name} is not a column of log.csv"
+            );
+        }
+    }
+
     /// A finished run of `iterations` iterations in a new folder `run` under `tmp`.
     fn finished(tmp: &Path, iterations: u64) -> PathBuf {
         let resolved = RunSpec {
