@@ -151,7 +151,7 @@ pub fn estimate(spec: &EstimateSpec) -> Result<EstimateReport> {
     } else {
         GaussianPolicy::new(spec.v.clone(), vec![spec.sigma.ln(); env.action_dim()], p)
     }
-    .map_err(|e| Error::invalid(format!("invalid policy for {}: {e}", spec.env)).with_source(e))?;
+    .map_err(|e| Error::invalid_from(format!("invalid policy for {}", spec.env), e))?;
     let key = SeedKey::new(spec.seed, 0, 0);
     let start = Instant::now();
     let rollout_error = |e: sepg_mdp::monte_carlo::McError| Error::failed(e.to_string());

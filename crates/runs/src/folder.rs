@@ -60,14 +60,12 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = output_builder(0o644).tempfile_in(dir).map_err(|e| {
-        Error::failed(format!("cannot write in {}: {e}", dir.display())).with_source(e)
-    })?;
+    let mut tmp = output_builder(0o644)
+        .tempfile_in(dir)
+        .map_err(|e| Error::failed_from(format!("cannot write in {}", dir.display()), e))?;
     tmp.write_all(contents)
         .and_then(|()| tmp.as_file().sync_all())
-        .map_err(|e| {
-            Error::failed(format!("cannot write {}: {e}", path.display())).with_source(e)
-        })?;
+        .map_err(|e| Error::failed_from(format!("cannot write {}", path.display()), e))?;
     tmp.persist(path).map_err(|e| {
         Error::failed(format!("cannot write {}: {}", path.display(), e.error)).with_source(e.error)
     })?;
@@ -95,7 +93,7 @@ pub(crate) fn output_builder<'a, 'b>(mode: u32) -> tempfile::Builder<'a, 'b> {
 /// [`Error::Failed`] if serialisation fails.
 pub fn to_json_line<T: serde::Serialize>(value: &T) -> Result<String> {
     let mut s = serde_json::to_string_pretty(value)
-        .map_err(|e| Error::failed(format!("cannot serialise output: {e}")).with_source(e))?;
+        .map_err(|e| Error::failed_from("cannot serialise output", e))?;
     s.push('\n');
     Ok(s)
 }
@@ -441,7 +439,7 @@ impl UsedConstants {
 
 /// [`Error::Failed`] for the I/O error `e` while doing `what` to `path`.
 pub(crate) fn io_fail(what: &str, path: &Path, e: std::io::Error) -> Error {
-    Error::failed(format!("cannot {what} {}: {e}", path.display())).with_source(e)
+    Error::failed_from(format!("cannot {what} {}", path.display()), e)
 }
 
 /// Checks, without creating anything, that the absent folder `dir` can be created: its
@@ -493,9 +491,8 @@ pub fn check_out_dir(dir: &Path, force: bool, files: &[&str]) -> Result<()> {
             dir.display()
         )));
     }
-    let mut entries = fs::read_dir(dir).map_err(|e| {
-        Error::invalid(format!("cannot read {}: {e}", dir.display())).with_source(e)
-    })?;
+    let mut entries = fs::read_dir(dir)
+        .map_err(|e| Error::invalid_from(format!("cannot read {}", dir.display()), e))?;
     if entries.next().is_some() && !force {
         return Err(Error::invalid(format!(
             "output folder {} is not empty (use --force to overwrite its run files)",
@@ -561,7 +558,7 @@ pub fn read_summary(dir: &Path) -> Result<Summary> {
     let p = dir.join(SUMMARY_FILE);
     let text = fs::read_to_string(&p).map_err(|e| io_fail("read", &p, e))?;
     serde_json::from_str(&text)
-        .map_err(|e| Error::failed(format!("{} is invalid: {e}", p.display())).with_source(e))
+        .map_err(|e| Error::failed_from(format!("{} is invalid", p.display()), e))
 }
 
 /// A log read back from disk: column names and one row of numbers per logged iteration
@@ -582,14 +579,12 @@ impl Log {
     pub fn read_run(dir: &Path) -> Result<Log> {
         let done = dir.join(LOG_FILE);
         let bytes = if done.is_file() {
-            fs::read(&done).map_err(|e| {
-                Error::invalid(format!("cannot read {}: {e}", done.display())).with_source(e)
-            })?
+            fs::read(&done)
+                .map_err(|e| Error::invalid_from(format!("cannot read {}", done.display()), e))?
         } else {
             let partial = dir.join(PARTIAL_LOG_FILE);
-            let mut b = fs::read(&partial).map_err(|e| {
-                Error::invalid(format!("no log in {}: {e}", dir.display())).with_source(e)
-            })?;
+            let mut b = fs::read(&partial)
+                .map_err(|e| Error::invalid_from(format!("no log in {}", dir.display()), e))?;
             let ck: Option<Checkpoint> = fs::read_to_string(dir.join(CHECKPOINT_FILE))
                 .ok()
                 .and_then(|t| serde_json::from_str(&t).ok());

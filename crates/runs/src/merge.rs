@@ -12,9 +12,8 @@ use crate::logcheck::validate_log;
 use crate::sweep::{SWEEP_FILE, Shard, SweepFile};
 
 fn copy_dir(from: &Path, to: &Path) -> Result<()> {
-    let fail = |p: &Path, e: std::io::Error| {
-        Error::failed(format!("cannot copy {}: {e}", p.display())).with_source(e)
-    };
+    let fail =
+        |p: &Path, e: std::io::Error| Error::failed_from(format!("cannot copy {}", p.display()), e);
     fs::create_dir_all(to).map_err(|e| fail(to, e))?;
     for entry in fs::read_dir(from).map_err(|e| fail(from, e))? {
         let entry = entry.map_err(|e| fail(from, e))?;
@@ -119,15 +118,12 @@ pub fn merge(shards: &[PathBuf], out: &Path, force: bool) -> Result<SweepFile> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    fs::create_dir_all(&parent).map_err(|e| {
-        Error::failed(format!("cannot create {}: {e}", parent.display())).with_source(e)
-    })?;
+    fs::create_dir_all(&parent)
+        .map_err(|e| Error::failed_from(format!("cannot create {}", parent.display()), e))?;
     let tmp = crate::folder::output_builder(0o755)
         .prefix(".sepg-merge-")
         .tempdir_in(&parent)
-        .map_err(|e| {
-            Error::failed(format!("cannot write in {}: {e}", parent.display())).with_source(e)
-        })?;
+        .map_err(|e| Error::failed_from(format!("cannot write in {}", parent.display()), e))?;
     for (dir, f) in &shards {
         for r in f.shard_runs() {
             copy_dir(&dir.join(&r.dir), &tmp.path().join(&r.dir))?;
@@ -138,14 +134,12 @@ pub fn merge(shards: &[PathBuf], out: &Path, force: bool) -> Result<SweepFile> {
         to_json_line(&merged)?.as_bytes(),
     )?;
     if out.exists() {
-        fs::remove_dir_all(out).map_err(|e| {
-            Error::failed(format!("cannot replace {}: {e}", out.display())).with_source(e)
-        })?;
+        fs::remove_dir_all(out)
+            .map_err(|e| Error::failed_from(format!("cannot replace {}", out.display()), e))?;
     }
     let built = tmp.keep();
-    fs::rename(&built, out).map_err(|e| {
-        Error::failed(format!("cannot create {}: {e}", out.display())).with_source(e)
-    })?;
+    fs::rename(&built, out)
+        .map_err(|e| Error::failed_from(format!("cannot create {}", out.display()), e))?;
     crate::sweep::write_summary_csv(out, &merged, false)?;
     Ok(merged)
 }

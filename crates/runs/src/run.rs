@@ -164,15 +164,13 @@ pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
         return Ok(summary);
     }
     let ck_path = dir.join(CHECKPOINT_FILE);
-    let text = fs::read_to_string(&ck_path).map_err(|e| {
-        Error::invalid(format!("cannot read {}: {e}", ck_path.display())).with_source(e)
-    })?;
+    let text = fs::read_to_string(&ck_path)
+        .map_err(|e| Error::invalid_from(format!("cannot read {}", ck_path.display()), e))?;
     let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| {
-        Error::invalid(format!(
-            "{} is not a valid checkpoint: {e}",
-            ck_path.display()
-        ))
-        .with_source(e)
+        Error::invalid_from(
+            format!("{} is not a valid checkpoint", ck_path.display()),
+            e,
+        )
     })?;
     let partial = dir.join(PARTIAL_LOG_FILE);
     let finished = dir.join(LOG_FILE);
@@ -187,9 +185,10 @@ pub fn resume(dir: &Path, opts: RunOptions<'_>) -> Result<Summary> {
 
 /// Cuts the partial log back to the `log_bytes` its checkpoint vouches for.
 fn truncate_log(partial: &Path, log_bytes: u64) -> Result<()> {
-    let file = OpenOptions::new().write(true).open(partial).map_err(|e| {
-        Error::invalid(format!("cannot open {}: {e}", partial.display())).with_source(e)
-    })?;
+    let file = OpenOptions::new()
+        .write(true)
+        .open(partial)
+        .map_err(|e| Error::invalid_from(format!("cannot open {}", partial.display()), e))?;
     let len = file
         .metadata()
         .map_err(|e| io_fail("read", partial, e))?

@@ -66,13 +66,12 @@ impl RunSpec {
         let certified_steps = algo.is_sepg().then(|| self.certified_steps.unwrap_or(true));
         let checked = config
             .check()
-            .map_err(|e| Error::invalid(format!("invalid configuration: {e}")).with_source(e))?
+            .map_err(|e| Error::invalid_from("invalid configuration", e))?
             .with_certified_steps(certified_steps.unwrap_or(true));
         // The first iteration builds the policy θ⁰: refuse here what it would refuse there.
         let first = checked.initial_state();
-        GaussianPolicy::new(first.v, first.w, feature_dim).map_err(|e| {
-            Error::invalid(format!("invalid initial policy (v0, sigma0): {e}")).with_source(e)
-        })?;
+        GaussianPolicy::new(first.v, first.w, feature_dim)
+            .map_err(|e| Error::invalid_from("invalid initial policy (v0, sigma0)", e))?;
         let spec = RunSpec {
             name: Some(self.name.clone().unwrap_or_else(|| algo.name().to_owned())),
             env: Some(env_name),
@@ -318,7 +317,7 @@ pub(super) fn build_env(name: EnvName, features: Option<&str>) -> Result<AnyEnv>
                 let k: usize = k.parse().map_err(|_| bad())?;
                 let v: usize = v.parse().map_err(|_| bad())?;
                 MountainCar::rbf([k, v], true)
-                    .map_err(|e| Error::invalid(format!("features {f:?}: {e}")).with_source(e))?
+                    .map_err(|e| Error::invalid_from(format!("features {f:?}"), e))?
             }
         }),
     })

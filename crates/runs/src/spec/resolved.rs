@@ -44,8 +44,7 @@ impl Resolved {
     /// # Errors
     /// [`Error::Invalid`] if the algorithm refuses the configuration or the batch rule.
     pub fn solver(&self) -> Result<PolicySolver> {
-        let invalid =
-            |e: ConfigError| Error::invalid(format!("invalid configuration: {e}")).with_source(e);
+        let invalid = |e: ConfigError| Error::invalid_from("invalid configuration", e);
         let solver = PolicySolver::new(&self.checked).map_err(invalid)?;
         match self.batch_rule() {
             BatchRule::Fixed => Ok(solver),
@@ -61,9 +60,8 @@ impl Resolved {
     /// # Errors
     /// [`Error::Failed`] if serialisation fails.
     pub fn toml(&self) -> Result<String> {
-        let mut text = toml::to_string(&self.spec).map_err(|e| {
-            Error::failed(format!("cannot serialise the configuration: {e}")).with_source(e)
-        })?;
+        let mut text = toml::to_string(&self.spec)
+            .map_err(|e| Error::failed_from("cannot serialise the configuration", e))?;
         let used = crate::folder::UsedConstants::of(self);
         text.push_str(&format!(
             "# constants used by the bounds: {}",

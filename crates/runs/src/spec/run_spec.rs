@@ -288,9 +288,8 @@ impl RunSpec {
     /// # Errors
     /// [`Error::Invalid`] for a missing or unreadable file or an invalid key or value.
     pub fn from_file(path: &Path) -> Result<RunSpec> {
-        let text = fs::read_to_string(path).map_err(|e| {
-            Error::invalid(format!("cannot read {}: {e}", path.display())).with_source(e)
-        })?;
+        let text = fs::read_to_string(path)
+            .map_err(|e| Error::invalid_from(format!("cannot read {}", path.display()), e))?;
         toml::from_str(&text)
             .map_err(|e| Error::invalid(format!("{}: {}", path.display(), toml_message(&e))))
     }
