@@ -736,13 +736,35 @@ fn gpomdp_constant(
 ) {
     let rows = s.chunks_exact(h * comps).zip(rewards.chunks_exact(h));
     if comps == 1 {
-        for (x, (s, f)) in out.iter_mut().zip(rows) {
+        // Four trajectories at a time: independent dependency chains, each summed in the
+        // order of `t` as one trajectory alone would be (the same bits).
+        const BLOCK: usize = 4;
+        let n = out.len().min(rows.len());
+        let mut blocks = out[..n].chunks_exact_mut(BLOCK);
+        let mut r = 0;
+        for x in &mut blocks {
+            let s: [&[f64]; BLOCK] = std::array::from_fn(|q| &s[(r + q) * h..][..h]);
+            let f: [&[f64]; BLOCK] = std::array::from_fn(|q| &rewards[(r + q) * h..][..h]);
+            let (mut acc, mut discount) = ([0.0; BLOCK], 1.0);
+            for t in 0..h {
+                let shift = discount * b;
+                for q in 0..BLOCK {
+                    acc[q] += s[q][t] * (f[q][t] - shift);
+                }
+                discount *= gamma;
+            }
+            x.copy_from_slice(&acc);
+            r += BLOCK;
+        }
+        for x in blocks.into_remainder() {
+            let (s, f) = (&s[r * h..][..h], &rewards[r * h..][..h]);
             let (mut acc, mut discount) = (0.0, 1.0);
             for (s, f) in s.iter().zip(f) {
                 acc += s * (f - discount * b);
                 discount *= gamma;
             }
             *x = acc;
+            r += 1;
         }
         return;
     }
