@@ -338,20 +338,15 @@ impl Checker {
         self.bounds.clear();
         self.bounds.extend(self.discs.iter().map(|d| d * slack));
         let sign = limits.non_positive;
-        for i in 0..batch.n {
+        let lengths = batch.lengths[..batch.n].iter();
+        let checked: usize = lengths.map(|&l| l.min(self.bounds.len())).sum();
+        self.tally.rewards_checked += checked as u64;
+        // the common case in branch-free passes; the offending steps only when there are
+        let mut from = 0;
+        while let Some(i) = next_offending(batch, &self.bounds, sign, from) {
+            from = i + 1;
             let row = batch.rewards(i);
             let len = batch.lengths[i].min(self.bounds.len());
-            self.tally.rewards_checked += len as u64;
-            // the common case in one branch-free pass; the offending steps only when there are
-            let any = row[..len]
-                .iter()
-                .zip(&self.bounds)
-                .fold(false, |bad, (dr, b)| {
-                    bad | (dr.abs() > *b) | (sign & (*dr > 0.0))
-                });
-            if !any {
-                continue;
-            }
             let steps = row[..len].iter().zip(&self.discs).zip(&self.bounds);
             for (t, ((&dr, &disc), &bound)) in steps.enumerate() {
                 Self::count_reward(
@@ -444,6 +439,38 @@ impl Checker {
     }
 }
 
+/// The first trajectory `i ≥ from` of `batch` with a discounted reward beyond its bound
+/// (`|γᵗ r_t| > bounds[t]`) or, when `sign`, above 0; each row is read up to its length and
+/// `bounds.len()`. On x86-64 processors with AVX2 the comparisons run in a build for AVX2
+/// (four lanes; a comparison does not round, so the answer is the same).
+fn next_offending(batch: &Batch, bounds: &[f64], sign: bool, from: usize) -> Option<usize> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor supports AVX2, the only feature `next_offending_avx2` is
+        // built for.
+        return unsafe { next_offending_avx2(batch, bounds, sign, from) };
+    }
+    next_offending_any(batch, bounds, sign, from)
+}
+
+/// [`next_offending`] built for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn next_offending_avx2(batch: &Batch, bounds: &[f64], sign: bool, from: usize) -> Option<usize> {
+    next_offending_any(batch, bounds, sign, from)
+}
+
+#[inline(always)]
+fn next_offending_any(batch: &Batch, bounds: &[f64], sign: bool, from: usize) -> Option<usize> {
+    (from..batch.n).find(|&i| {
+        let len = batch.lengths[i].min(bounds.len());
+        let row = &batch.rewards(i)[..len];
+        row.iter().zip(bounds).fold(false, |bad, (dr, b)| {
+            bad | (dr.abs() > *b) | (sign & (*dr > 0.0))
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -517,6 +544,48 @@ mod tests {
         assert_eq!((o.trajectory, o.step, o.what), (1, 2, Constant::RMax));
         assert!((o.value + 1.5).abs() <= 4.0 * f64::EPSILON * 1.5);
         assert_eq!((c.tally.r_max, c.tally.rewards_checked), (1, 6));
+    }
+
+    /// The first offending trajectory from every starting row, with and without the sign
+    /// check, against a plain loop over the steps; on processors with AVX2, the AVX2 build
+    /// and the portable one agree.
+    #[test]
+    fn the_first_offending_trajectory_is_found_from_every_row() {
+        let (n, h) = (9, 7);
+        let mut b = Batch::zeros(n, h, 1, 1, 0.9);
+        for (k, x) in b.disc_rewards.iter_mut().enumerate() {
+            *x = -((k % 5) as f64) * 0.1;
+        }
+        b.disc_rewards[2 * h + 6] = -3.0; // beyond the bound, at the last step
+        b.disc_rewards[5 * h + 1] = 2.5; // beyond the bound and positive
+        b.disc_rewards[7 * h] = 0.25; // positive only
+        b.disc_rewards[8 * h + 5] = -9.0; // beyond the bound, but past the row's length
+        b.lengths = vec![7, 7, 7, 6, 7, 7, 7, 7, 5];
+        let bounds = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0];
+        let plain = |sign: bool, from: usize| {
+            (from..n).find(|&i| {
+                let len = b.lengths[i].min(bounds.len());
+                (0..len).any(|t| {
+                    let r = b.disc_rewards[i * h + t];
+                    r.abs() > bounds[t] || (sign && r > 0.0)
+                })
+            })
+        };
+        let mut found = Vec::new();
+        for sign in [false, true] {
+            for from in 0..=n {
+                let got = next_offending(&b, &bounds, sign, from);
+                assert_eq!(got, plain(sign, from), "sign {sign} from {from}");
+                #[cfg(target_arch = "x86_64")]
+                assert_eq!(got, next_offending_any(&b, &bounds, sign, from));
+                found.push(got);
+            }
+        }
+        // row 2's offence is at step 6, beyond the 6 bounds: never seen; row 8's is past its
+        // length
+        assert_eq!(found[0], Some(5));
+        assert_eq!(found[n + 1 + 6], Some(7));
+        assert_eq!(found[8], None);
     }
 
     /// Values within [`SLACK`] of their bound are not counted, values beyond it are.
