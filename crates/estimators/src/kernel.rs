@@ -154,6 +154,15 @@ fn grow(v: &mut Vec<f64>, len: usize) {
     }
 }
 
+/// The arguments of one call of [`Sums::run`], handed to the build that runs it.
+struct Fit<'a, const K: usize> {
+    inputs: [Rows<'a>; K],
+    /// `(rows, width, comps)`.
+    shape: (usize, usize, usize),
+    choice: (Baseline, BaselineFit),
+    output: Output<'a>,
+}
+
 impl Sums {
     /// Fits the baseline of `F` over `rows` trajectories of `width` entries with inputs
     /// `inputs`, and writes the samples (`comps` per trajectory, `width = steps · comps`) or
@@ -174,45 +183,37 @@ impl Sums {
         fit: BaselineFit,
         output: Output<'_>,
     ) {
+        let job = Fit {
+            inputs,
+            shape: (rows, width, comps),
+            choice: (baseline, fit),
+            output,
+        };
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor supports AVX2, the only feature `run_avx2` is built for.
-            unsafe { self.run_avx2::<K, F>(inputs, rows, width, comps, baseline, fit, output) };
+            unsafe { self.run_avx2::<K, F>(job) };
             return;
         }
-        self.run_any::<K, F>(inputs, rows, width, comps, baseline, fit, output);
+        self.run_any::<K, F>(job);
     }
 
     /// [`Sums::run`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    fn run_avx2<const K: usize, F: Formula<K>>(
-        &mut self,
-        inputs: [Rows<'_>; K],
-        rows: usize,
-        width: usize,
-        comps: usize,
-        baseline: Baseline,
-        fit: BaselineFit,
-        output: Output<'_>,
-    ) {
-        self.run_any::<K, F>(inputs, rows, width, comps, baseline, fit, output);
+    fn run_avx2<const K: usize, F: Formula<K>>(&mut self, job: Fit<'_, K>) {
+        self.run_any::<K, F>(job);
     }
 
     /// The passes of [`Sums::run`], inlined into each build of it.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn run_any<const K: usize, F: Formula<K>>(
-        &mut self,
-        inputs: [Rows<'_>; K],
-        rows: usize,
-        width: usize,
-        comps: usize,
-        baseline: Baseline,
-        fit: BaselineFit,
-        output: Output<'_>,
-    ) {
+    fn run_any<const K: usize, F: Formula<K>>(&mut self, job: Fit<'_, K>) {
+        let Fit {
+            inputs,
+            shape: (rows, width, comps),
+            choice: (baseline, fit),
+            output,
+        } = job;
         let keep_base = matches!(output, Output::Baselines);
         // Row r + 1 of `suf_num` receives trajectory r's sample terms (or baselines).
         grow(&mut self.suf_num, (rows + 1) * width);
@@ -440,14 +441,12 @@ pub(crate) fn pgt_sample(s: &[f64], f: &[f64], base: &[f64], x: &mut [f64]) {
 mod tests {
     use super::*;
 
-    /// Every fit, output and formula of [`Sums::run`] on `rows` trajectories of `width`
-    /// entries, by `build(sums, inputs, baseline, fit, output)`; the samples or baselines
-    /// as bits.
-    fn all_fits(
-        rows: usize,
-        width: usize,
-        comps: usize,
-        build: impl Fn(&mut Sums, [Rows<'_>; 3], Baseline, BaselineFit, Output<'_>),
+    /// Every fit and output of [`Sums::run`] on `rows` trajectories of `width` entries (the
+    /// inputs chosen by `pick`), run by `build`; the samples or baselines as bits.
+    fn all_fits<const K: usize>(
+        (rows, width, comps): (usize, usize, usize),
+        pick: for<'a> fn([Rows<'a>; 3]) -> [Rows<'a>; K],
+        build: impl Fn(&mut Sums, Fit<'_, K>),
     ) -> Vec<u64> {
         // Deterministic, irregular inputs of both signs, with exact zeros (0/0 baselines).
         let data: Vec<f64> = (0..3 * rows * width)
@@ -458,15 +457,26 @@ mod tests {
             .collect();
         let (a, rest) = data.split_at(rows * width);
         let (b, c) = rest.split_at(rows * width);
-        let inputs = [a, b, c].map(|d| Rows::new(d, width));
+        let inputs = pick([a, b, c].map(|d| Rows::new(d, width)));
         let mut bits = Vec::new();
         for baseline in [Baseline::None, Baseline::Optimal] {
             for fit in [BaselineFit::PlugIn, BaselineFit::LeaveOneOut] {
                 let mut sums = Sums::default();
                 let mut out = vec![0.0; rows * comps];
-                build(&mut sums, inputs, baseline, fit, Output::Sums(&mut out));
+                for output in [Output::Sums(&mut out), Output::Baselines] {
+                    let shape = (rows, width, comps);
+                    let choice = (baseline, fit);
+                    build(
+                        &mut sums,
+                        Fit {
+                            inputs,
+                            shape,
+                            choice,
+                            output,
+                        },
+                    );
+                }
                 bits.extend(out.iter().map(|x| x.to_bits()));
-                build(&mut sums, inputs, baseline, fit, Output::Baselines);
                 let base = sums.baselines(width);
                 for r in 0..rows {
                     bits.extend(base.row(r, width).iter().map(|x| x.to_bits()));
@@ -474,6 +484,14 @@ mod tests {
             }
         }
         bits
+    }
+
+    fn two<'a>([a, b, _]: [Rows<'a>; 3]) -> [Rows<'a>; 2] {
+        [a, b]
+    }
+
+    fn three<'a>(i: [Rows<'a>; 3]) -> [Rows<'a>; 3] {
+        i
     }
 
     /// The AVX2 build of the fits computes the same bits as the portable one, for every
@@ -486,29 +504,15 @@ mod tests {
             return;
         }
         for (rows, steps, comps) in [(1, 1, 1), (5, 7, 1), (9, 20, 1), (6, 3, 3), (13, 5, 2)] {
-            let width = steps * comps;
+            let shape = (rows, steps * comps, comps);
             macro_rules! both {
                 ($k:literal, $f:ty, $pick:expr) => {{
-                    let portable = all_fits(rows, width, comps, |s, i, b, f, o| {
-                        s.run_any::<$k, $f>($pick(i), rows, width, comps, b, f, o)
-                    });
+                    let portable = all_fits::<$k>(shape, $pick, |s, job| s.run_any::<$k, $f>(job));
                     // SAFETY: AVX2 was detected above.
-                    let avx2 = all_fits(rows, width, comps, |s, i, b, f, o| unsafe {
-                        s.run_avx2::<$k, $f>($pick(i), rows, width, comps, b, f, o)
-                    });
-                    assert_eq!(
-                        portable,
-                        avx2,
-                        "{} rows {rows} width {width}",
-                        stringify!($f)
-                    );
+                    let avx2 =
+                        all_fits::<$k>(shape, $pick, |s, job| unsafe { s.run_avx2::<$k, $f>(job) });
+                    assert_eq!(portable, avx2, "{} {shape:?}", stringify!($f));
                 }};
-            }
-            fn two<'a>([a, b, _]: [Rows<'a>; 3]) -> [Rows<'a>; 2] {
-                [a, b]
-            }
-            fn three<'a>(i: [Rows<'a>; 3]) -> [Rows<'a>; 3] {
-                i
             }
             both!(2, Score<true>, two);
             both!(2, Score<false>, two);
