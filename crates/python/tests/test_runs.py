@@ -108,6 +108,22 @@ def test_python_and_command_line_write_the_same_run_folder(tmp_path):
     assert files(tmp_path / "py") == files(tmp_path / "cli")
 
 
+@pytest.mark.skipif(not CLI.is_file(), reason="the sepg binary is built by `bash scripts/test.sh`")
+def test_the_adaptive_batch_rule_runs_from_python_as_from_the_command_line(tmp_path):
+    args = dict(env="lqg1d", algo="sepg-mi", iterations=4, batch=100, seed=3,
+                batch_rule="adaptive", batch_min=60, batch_max=400)
+    runs.run(tmp_path / "py", **args)
+    flags = [x for k, v in args.items() for x in (f"--{k.replace('_', '-')}", str(v))]
+    subprocess.run([str(CLI), "run", "--quiet", "--out", str(tmp_path / "cli"), *flags], check=True)
+    assert files(tmp_path / "py") == files(tmp_path / "cli")
+    log = runs.read_run(tmp_path / "py").log
+    # At v0 = -0.1, sigma = 1 the proven v-width of a 50-trajectory block is about 23 times
+    # |dJ/dv|, so the rule's n* = 4 b^2 / g^2 (about 1e5, docs/REPRODUCTION.md) is clamped to
+    # batch_max: after the first iteration (N = 100), two blocks of 400 per iteration.
+    per_iteration = np.diff(np.asarray(log["trajectories"]))
+    assert list(per_iteration) == [800, 800, 800]
+
+
 def test_a_dask_sweep_equals_the_local_sweep_byte_for_byte(tmp_path):
     dask = pytest.importorskip("dask")
     local = runs.sweep(SWEEP, tmp_path / "local", engine="local")
