@@ -8,38 +8,38 @@
 
 use std::path::Path;
 
-use crate::common::{assert_usage_error, sepg, sepg_ok};
+use crate::common::{assert_usage_error, sepg, sepg_ok, with_out};
 
 /// The arguments of a short sampled SEPG-ZV run on `lqg1d` into `out`, then `extra`.
 fn short_run(out: &Path, extra: &[&str]) -> Vec<String> {
-    [
-        "run",
-        "--env",
-        "lqg1d",
-        "--algo",
-        "sepg-zv",
-        "--iterations",
-        "12",
-        "--batch",
-        "24",
-        "--seed",
-        "5",
-        // the proven widths take no step at N = 24: Student-t widths, so that steps are taken
-        "--confidence",
-        "student-t",
-        // the thesis's constants: under the tight ones iteration 0's w-requirement of 0 is
-        // found uncertifiable by the certified path (λ_w = 0, infeasible_w = 1) where the f64
-        // path takes a zero step, so λ_w differs beyond the certification's columns
-        "--constants",
-        "thesis",
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([out.display().to_string()])
-    .chain(extra.iter().map(|s| s.to_string()))
-    .collect()
+    let mut args = with_out(
+        &[
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-zv",
+            "--iterations",
+            "12",
+            "--batch",
+            "24",
+            "--seed",
+            "5",
+            // the proven widths take no step at N = 24: Student-t widths, so that steps are taken
+            "--confidence",
+            "student-t",
+            // the thesis's constants: under the tight ones iteration 0's w-requirement of 0 is
+            // found uncertifiable by the certified path (λ_w = 0, infeasible_w = 1) where the f64
+            // path takes a zero step, so λ_w differs beyond the certification's columns
+            "--constants",
+            "thesis",
+            "--quiet",
+            "--out",
+        ],
+        out,
+    );
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
 }
 
 fn read(p: &Path) -> String {

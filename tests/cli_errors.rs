@@ -3,7 +3,7 @@
 //!
 //! Cost: one estimate of 4,000 trajectories of 20 steps; the rest fail at parsing.
 
-use crate::common::{assert_usage_error, get, json_ok, sepg};
+use crate::common::{assert_usage_error, get, json_ok, sepg, with_out};
 
 #[test]
 fn a_missing_flag_is_named() {
@@ -450,23 +450,22 @@ fn ctrl_c_stops_inside_a_long_iteration_and_the_run_resumes_identically() {
 
     let tmp = tempfile::tempdir().expect("tempdir");
     let args = |dir: &std::path::Path| {
-        [
-            "run",
-            "--env",
-            "lqg1d",
-            "--gradients",
-            "exact",
-            "--horizon",
-            "100000",
-            "--iterations",
-            "2",
-            "--quiet",
-            "--out",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .chain([dir.display().to_string()])
-        .collect::<Vec<_>>()
+        with_out(
+            &[
+                "run",
+                "--env",
+                "lqg1d",
+                "--gradients",
+                "exact",
+                "--horizon",
+                "100000",
+                "--iterations",
+                "2",
+                "--quiet",
+                "--out",
+            ],
+            dir,
+        )
     };
     let dir = tmp.path().join("interrupted");
     let mut child = Command::new(env!("CARGO_BIN_EXE_sepg"))

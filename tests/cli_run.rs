@@ -8,7 +8,7 @@ use std::time::Duration;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-use crate::common::{assert_usage_error, readme_run, sepg, sepg_ok};
+use crate::common::{assert_usage_error, readme_run, sepg, sepg_ok, with_out};
 
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
@@ -114,19 +114,18 @@ fn flags_override_the_config_file_and_multi_dimensional_columns_are_indexed() {
     )
     .expect("write");
     let dir = tmp.path().join("mc");
-    let args: Vec<String> = [
-        "run",
-        "--config",
-        cfg.to_str().expect("utf-8"),
-        "--iterations",
-        "2",
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([dir.display().to_string()])
-    .collect();
+    let args = with_out(
+        &[
+            "run",
+            "--config",
+            cfg.to_str().expect("utf-8"),
+            "--iterations",
+            "2",
+            "--quiet",
+            "--out",
+        ],
+        &dir,
+    );
     sepg_ok(&args);
     let config = read(&dir.join("config.toml"));
     assert!(
@@ -927,27 +926,26 @@ fn exact_mi_with_the_tight_constants_reaches_the_clipped_optimum_without_a_viola
 /// The arguments of a safe-Adam run: exact-gradient SEPG-MI on `lqg1d` from σ⁰ = 1, Adam's
 /// learning rate 0.1, into `dir`.
 fn safe_adam_args(dir: &Path, iterations: &str) -> Vec<String> {
-    [
-        "run",
-        "--env",
-        "lqg1d",
-        "--algo",
-        "sepg-mi",
-        "--v-direction",
-        "adam",
-        "--adam-lr",
-        "0.1",
-        "--gradients",
-        "exact",
-        "--iterations",
-        iterations,
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([dir.display().to_string()])
-    .collect()
+    with_out(
+        &[
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-mi",
+            "--v-direction",
+            "adam",
+            "--adam-lr",
+            "0.1",
+            "--gradients",
+            "exact",
+            "--iterations",
+            iterations,
+            "--quiet",
+            "--out",
+        ],
+        dir,
+    )
 }
 
 /// Safe Adam on the command line: the run records its v-direction with Adam's usual betas in
@@ -1068,27 +1066,26 @@ fn safe_adam_where_unproven_is_one_line_exit_2() {
 /// The arguments of a sampled SEPG-MI run on `lqg1d` with the adaptive batch rule, each block
 /// clamped to [2,000, 2,100] trajectories.
 fn adaptive_args(dir: &Path, iterations: &str) -> Vec<String> {
-    [
-        "run",
-        "--env",
-        "lqg1d",
-        "--algo",
-        "sepg-mi",
-        "--iterations",
-        iterations,
-        "--batch-rule",
-        "adaptive",
-        "--batch-min",
-        "2000",
-        "--batch-max",
-        "2100",
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([dir.display().to_string()])
-    .collect()
+    with_out(
+        &[
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-mi",
+            "--iterations",
+            iterations,
+            "--batch-rule",
+            "adaptive",
+            "--batch-min",
+            "2000",
+            "--batch-max",
+            "2100",
+            "--quiet",
+            "--out",
+        ],
+        dir,
+    )
 }
 
 /// The adaptive batch rule on the command line reaches the algorithm: the first iteration

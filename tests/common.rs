@@ -39,35 +39,43 @@ pub fn sepg_ok<S: AsRef<OsStr>>(args: &[S]) -> Output {
 /// ```
 pub fn readme_run(out: &Path, iterations: u64) -> Vec<String> {
     let iterations = iterations.to_string();
-    [
-        "run",
-        "--env",
-        "lqg1d",
-        "--algo",
-        "sepg-zv",
-        "--gradients",
-        "sampled",
-        "--v0",
-        "-0.1",
-        "--sigma0",
-        "1.0",
-        "--iterations",
-        &iterations,
-        "--batch",
-        "100",
-        "--horizon",
-        "20",
-        "--delta",
-        "0.2",
-        "--seed",
-        "1",
-        "--quiet",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .chain([out.display().to_string()])
-    .collect()
+    with_out(
+        &[
+            "run",
+            "--env",
+            "lqg1d",
+            "--algo",
+            "sepg-zv",
+            "--gradients",
+            "sampled",
+            "--v0",
+            "-0.1",
+            "--sigma0",
+            "1.0",
+            "--iterations",
+            &iterations,
+            "--batch",
+            "100",
+            "--horizon",
+            "20",
+            "--delta",
+            "0.2",
+            "--seed",
+            "1",
+            "--quiet",
+            "--out",
+        ],
+        out,
+    )
+}
+
+/// The arguments `args` followed by the path `out` (the value of a final `--out`), as
+/// strings.
+pub fn with_out(args: &[&str], out: &Path) -> Vec<String> {
+    args.iter()
+        .map(|s| s.to_string())
+        .chain([out.display().to_string()])
+        .collect()
 }
 
 /// Asserts the contract for bad input: exit status 2, nothing on standard output, exactly
