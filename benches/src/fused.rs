@@ -273,11 +273,8 @@ pub struct ZvIteration {
     dr: Vec<f64>,
     /// The target block's returns.
     returns: Vec<f64>,
-    /// Suffix sums of the leave-one-out fits (`(rows + 1) × h`) and prefix sums (`h`).
-    suf_n: Vec<f64>,
-    suf_d: Vec<f64>,
-    pre_n: Vec<f64>,
-    pre_d: Vec<f64>,
+    /// The buffers of the leave-one-out fits.
+    loo: Loo,
     /// Per-trajectory samples of ∇̂_v J, ∂̂_σ ∇_v J and ∇̂_w L (w-block).
     g: Vec<f64>,
     d: Vec<f64>,
@@ -352,10 +349,7 @@ impl ZvIteration {
             sw: Vec::new(),
             dr: Vec::new(),
             returns: Vec::new(),
-            suf_n: Vec::new(),
-            suf_d: Vec::new(),
-            pre_n: Vec::new(),
-            pre_d: Vec::new(),
+            loo: Loo::default(),
             g: Vec::new(),
             d: Vec::new(),
             z: Vec::new(),
@@ -505,13 +499,7 @@ impl ZvIteration {
         };
         let (s, dr) = (&s[..n * h], &self.dr[..n * h]);
         self.g.resize(n, 0.0);
-        let mut fit = Loo {
-            suf_n: &mut self.suf_n,
-            suf_d: &mut self.suf_d,
-            pre_n: &mut self.pre_n,
-            pre_d: &mut self.pre_d,
-        };
-        fit.run(
+        self.loo.run(
             [s, dr],
             h,
             |[s, f]| score_term(s, f),
@@ -543,12 +531,7 @@ impl ZvIteration {
                 &self.sw[lo * h..hi * h],
                 &self.dr[lo * h..hi * h],
             );
-            let mut fit = Loo {
-                suf_n: &mut self.suf_n,
-                suf_d: &mut self.suf_d,
-                pre_n: &mut self.pre_n,
-                pre_d: &mut self.pre_d,
-            };
+            let fit = &mut self.loo;
             // ∇̂_v J, optimal baseline: terms (S² F, S²), sample S (F − b).
             fit.run(
                 [sv, dr],
@@ -629,14 +612,17 @@ impl ZvIteration {
 /// The leave-one-out fit of one estimator on `rows` trajectories of `h` steps: the baseline
 /// of trajectory `r` at step `t` is `Σ_{i≠r} num / Σ_{i≠r} den`, summed as prefix + suffix
 /// (the exact sum over the others), and `out[r] = Σ_t sample(r, t; b)`.
-struct Loo<'a> {
-    suf_n: &'a mut Vec<f64>,
-    suf_d: &'a mut Vec<f64>,
-    pre_n: &'a mut Vec<f64>,
-    pre_d: &'a mut Vec<f64>,
+#[derive(Debug, Clone, Default)]
+struct Loo {
+    /// Suffix sums over trajectories, `(rows + 1) × h`.
+    suf_n: Vec<f64>,
+    suf_d: Vec<f64>,
+    /// Prefix sums over trajectories, `h`.
+    pre_n: Vec<f64>,
+    pre_d: Vec<f64>,
 }
 
-impl Loo<'_> {
+impl Loo {
     /// The fit on the rows of `inputs` (`out.len()` rows of `h` entries each): `term` gives
     /// an entry's `(num, den)`, `sample` its sample term with the baseline.
     #[inline(always)]
@@ -650,7 +636,7 @@ impl Loo<'_> {
     ) {
         let rows = out.len();
         let used = (rows + 1) * h;
-        for buf in [&mut *self.suf_n, &mut *self.suf_d] {
+        for buf in [&mut self.suf_n, &mut self.suf_d] {
             if buf.len() < used {
                 buf.resize(used, 0.0);
             }
@@ -667,7 +653,7 @@ impl Loo<'_> {
                 sd[t] = sd_next[t] + d;
             }
         }
-        for buf in [&mut *self.pre_n, &mut *self.pre_d] {
+        for buf in [&mut self.pre_n, &mut self.pre_d] {
             buf.clear();
             buf.resize(h, 0.0);
         }
