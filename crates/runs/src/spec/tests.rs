@@ -330,19 +330,7 @@ fn the_adam_v_direction_resolves_round_trips_and_is_refused_where_unproven() {
 
 #[test]
 fn algorithm_names_are_the_configuration_names() {
-    let all = [
-        AlgoName::SepgMi,
-        AlgoName::SepgLb1,
-        AlgoName::SepgLb2,
-        AlgoName::SepgLv,
-        AlgoName::SepgZv,
-        AlgoName::SepgSim,
-        AlgoName::SepgNaiveW,
-        AlgoName::GpomdpConst,
-        AlgoName::GpomdpAdam,
-        AlgoName::Adastep,
-    ];
-    for algo in all {
+    for algo in AlgoName::ALL {
         let spec = RunSpec {
             algo: Some(algo),
             ..RunSpec::default()
