@@ -464,6 +464,7 @@ impl Estimator {
                 comps,
                 rewards,
                 (h, batch.gamma, b),
+                &mut self.shifted,
                 &mut out[..nr * comps],
             );
             return;
@@ -732,42 +733,24 @@ fn gpomdp_constant(
     comps: usize,
     rewards: &[f64],
     (h, gamma, b): (usize, f64, f64),
+    shift: &mut Vec<f64>,
     out: &mut [f64],
 ) {
-    let rows = s.chunks_exact(h * comps).zip(rewards.chunks_exact(h));
     if comps == 1 {
-        // Four trajectories at a time: independent dependency chains, each summed in the
-        // order of `t` as one trajectory alone would be (the same bits).
-        const BLOCK: usize = 4;
-        let n = out.len().min(rows.len());
-        let mut blocks = out[..n].chunks_exact_mut(BLOCK);
-        let mut r = 0;
-        for x in &mut blocks {
-            let s: [&[f64]; BLOCK] = std::array::from_fn(|q| &s[(r + q) * h..][..h]);
-            let f: [&[f64]; BLOCK] = std::array::from_fn(|q| &rewards[(r + q) * h..][..h]);
-            let (mut acc, mut discount) = ([0.0; BLOCK], 1.0);
-            for t in 0..h {
-                let shift = discount * b;
-                for q in 0..BLOCK {
-                    acc[q] += s[q][t] * (f[q][t] - shift);
-                }
-                discount *= gamma;
-            }
-            x.copy_from_slice(&acc);
-            r += BLOCK;
+        // γ^t b once per step, in a row shared by every trajectory (stride 0); the sums over
+        // time then run four trajectories at a time (`row_sums`), each in the order of `t`.
+        shift.clear();
+        let mut discount = 1.0;
+        for _ in 0..h {
+            shift.push(discount * b);
+            discount *= gamma;
         }
-        for x in blocks.into_remainder() {
-            let (s, f) = (&s[r * h..][..h], &rewards[r * h..][..h]);
-            let (mut acc, mut discount) = (0.0, 1.0);
-            for (s, f) in s.iter().zip(f) {
-                acc += s * (f - discount * b);
-                discount *= gamma;
-            }
-            *x = acc;
-            r += 1;
-        }
+        let inputs = [Rows::new(s, h), Rows::new(rewards, h), Rows::new(shift, 0)];
+        let n = out.len().min(rewards.len() / h);
+        row_sums(&mut out[..n], h, 0.0, inputs, |[s, f, b]| s * (f - b));
         return;
     }
+    let rows = s.chunks_exact(h * comps).zip(rewards.chunks_exact(h));
     for (x, (s, f)) in out.chunks_exact_mut(comps).zip(rows) {
         x.fill(0.0);
         let mut discount = 1.0;
